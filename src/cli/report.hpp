@@ -1,0 +1,27 @@
+#pragma once
+// Human-readable and JSON renderings of a match result.
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <ostream>
+
+#include "core/matcher.hpp"
+
+namespace tomomap::cli {
+
+/// Error of an estimate against ground truth, with the paper's success rule.
+struct GroundTruthCheck {
+  Pose4 expected;
+  PoseError error;
+  double translation_limit = 0;  ///< 5 x grid [m]
+  double yaw_limit = 0;          ///< 10 degrees [rad]
+  bool success() const { return error.translation < translation_limit && error.yaw < yaw_limit; }
+};
+
+GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const Eigen::Matrix4d& P_target,
+                                         const Eigen::Matrix4d& P_source, double grid);
+
+void printResult(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& gt);
+
+nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck>& gt);
+
+}  // namespace tomomap::cli

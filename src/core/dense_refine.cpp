@@ -1,0 +1,81 @@
+#include "dense_refine.hpp"
+
+#include <cmath>
+
+namespace tomomap {
+namespace {
+
+/// One slice pair: the target's occupancy image and the source's cell centres.
+struct PairCells {
+  cv::Mat target;                       // CV_8U, 255 = occupied
+  std::vector<Eigen::Vector2d> source;  // source cell centres [m]
+};
+
+std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& source, int offset) {
+  std::vector<PairCells> pairs;
+  for (int i = 0; i < target.size(); ++i) {
+    if (target.cells[static_cast<size_t>(i)].empty()) continue;
+    for (int j = i - offset - 1; j <= i - offset + 1; ++j) {
+      if (j < 0 || j >= source.size() || source.cells[static_cast<size_t>(j)].empty()) continue;
+      PairCells p{target.image(i), {}};
+      const auto& g = source.grid;
+      for (uint32_t idx : source.cells[static_cast<size_t>(j)])
+        p.source.push_back(g.toMetres(static_cast<float>(idx % static_cast<uint32_t>(g.width)),
+                                      static_cast<float>(idx / static_cast<uint32_t>(g.width)))
+                               .cast<double>());
+      pairs.push_back(std::move(p));
+    }
+  }
+  return pairs;
+}
+
+}  // namespace
+
+DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& source, int offset,
+                                    const Rigid2D& initial, const DenseRefineParams& params) {
+  DenseRefineResult result{initial, 0};
+  const std::vector<PairCells> pairs = collectPairs(target, source, offset);
+  if (pairs.empty()) return result;
+  const auto& tg = target.grid;
+  const double cell = tg.cell;
+
+  for (double radius_cells : params.radii_cells) {
+    const int r = static_cast<int>(std::ceil(radius_cells));
+    const double max_d2 = radius_cells * radius_cells;
+    for (int it = 0; it < params.iterations_per_stage; ++it) {
+      Correspondences c;
+      const Rigid2D& T = result.transform;
+      for (const auto& p : pairs) {
+        for (const auto& s : p.source) {
+          const Eigen::Vector2d q = T.apply(s);
+          // Target pixel coordinates (centres are integers).
+          const double fu = (q.x() - tg.x_min) / cell - 0.5, fv = (q.y() - tg.y_min) / cell - 0.5;
+          const int u0 = static_cast<int>(std::lround(fu)), v0 = static_cast<int>(std::lround(fv));
+          double best = max_d2;
+          int bu = -1, bv = -1;
+          for (int v = std::max(0, v0 - r); v <= std::min(tg.height - 1, v0 + r); ++v) {
+            const uint8_t* row = p.target.ptr<uint8_t>(v);
+            for (int u = std::max(0, u0 - r); u <= std::min(tg.width - 1, u0 + r); ++u) {
+              if (!row[u]) continue;
+              const double d2 = (u - fu) * (u - fu) + (v - fv) * (v - fv);
+              if (d2 <= best) {
+                best = d2;
+                bu = u;
+                bv = v;
+              }
+            }
+          }
+          if (bu < 0) continue;
+          c.source.push_back(s);
+          c.target.push_back(tg.toMetres(static_cast<float>(bu), static_cast<float>(bv)).cast<double>());
+        }
+      }
+      if (c.size() < 3) return result;
+      result.transform = fitRigid2D(c);
+      result.correspondences = c.size();
+    }
+  }
+  return result;
+}
+
+}  // namespace tomomap

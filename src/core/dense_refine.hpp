@@ -1,0 +1,26 @@
+#pragma once
+// Dense refinement of the planar part of a match on the slices' occupied cells.
+#include "rigid2d.hpp"
+#include "slices.hpp"
+
+namespace tomomap {
+
+struct DenseRefineParams {
+  std::vector<double> radii_cells{3.0, 2.0, 1.5};  ///< correspondence radius per stage [grid cells]
+  int iterations_per_stage = 8;
+};
+
+struct DenseRefineResult {
+  Rigid2D transform;
+  size_t correspondences = 0;  ///< cell pairs used in the last iteration
+};
+
+/// Feature keypoints sit on whole pixels and vertical structures repeat the same
+/// keypoint in many slices, so the feature fit alone leaves a yaw error of a few
+/// milliradians: 0.2 m at 50 m from the origin. This ICP over every occupied cell
+/// of the slice pairs at `offset` (target index - source index) and its two
+/// neighbours averages the pixel quantisation out over thousands of cells.
+DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& source, int offset,
+                                    const Rigid2D& initial, const DenseRefineParams& params = {});
+
+}  // namespace tomomap

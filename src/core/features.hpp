@@ -1,0 +1,38 @@
+#pragma once
+// ORB features per slice: the compact description of a map that crosses the network.
+#include <opencv2/core.hpp>
+
+#include "slices.hpp"
+
+namespace tomomap {
+
+struct FeatureParams {
+  int max_features = 1000;  ///< best-K ORB keypoints kept per slice
+  int fast_threshold = 20;  ///< FAST corner threshold on the 0/255 images
+  int pad = 32;             ///< empty border added before detection [pixels]; >= ORB's edge threshold
+};
+
+struct SliceFeatures {
+  int index = 0;                          ///< slice index within its map (0 = lowest kept slice)
+  std::vector<Eigen::Vector2f> keypoints; ///< map-frame x, y [m]
+  cv::Mat descriptors;                    ///< N x 32 CV_8U, 256-bit ORB descriptors
+};
+
+/// Everything the matcher needs of one map.
+struct MapFeatures {
+  double grid = 0;    ///< slice spacing = grid size [m]
+  double z_min = 0;   ///< height of slice 0 [m]
+  int slice_count = 0;
+  std::vector<SliceFeatures> slices;  ///< only slices with features, by increasing index
+  /// The slices' occupied cells, when available (always offline; over the network
+  /// when the sender ships them). Lets the matcher refine densely; may be empty.
+  SliceStack occupancy;
+
+  double sliceHeight(int k) const { return z_min + k * grid; }
+  size_t featureCount() const;
+};
+
+/// Detects ORB on every non-empty slice. Parallel over slices.
+MapFeatures extractFeatures(const SliceStack& stack, const FeatureParams& params = {});
+
+}  // namespace tomomap

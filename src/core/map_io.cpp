@@ -1,0 +1,158 @@
+#include "map_io.hpp"
+
+#include <pcl/common/io.h>
+#include <pcl/console/print.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace tomomap {
+namespace {
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+// PCL reports parse problems on stderr; we report them ourselves, once.
+void silencePcl() { pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); }
+
+Points fromPcl(const pcl::PointCloud<pcl::PointXYZ>& cloud) {
+  Points out;
+  out.reserve(cloud.size());
+  for (const auto& p : cloud) out.emplace_back(p.x, p.y, p.z);
+  return out;
+}
+
+Points loadPcl(const std::string& path, bool ply) {
+  silencePcl();
+  pcl::PCLPointCloud2 blob;
+  const int rc = ply ? pcl::io::loadPLYFile(path, blob) : pcl::io::loadPCDFile(path, blob);
+  if (rc < 0) throw InputError(path + ": not a readable " + (ply ? "PLY" : "PCD") + " file (corrupt or truncated)");
+  for (const char* axis : {"x", "y", "z"}) {
+    if (pcl::getFieldIndex(blob, axis) < 0)
+      throw InputError(path + ": has no '" + axis + "' field");
+  }
+  const size_t declared = static_cast<size_t>(blob.width) * blob.height;
+  if (blob.point_step == 0 || blob.data.size() < declared * blob.point_step)
+    throw InputError(path + ": truncated (header declares " + std::to_string(declared) + " points)");
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  pcl::fromPCLPointCloud2(blob, cloud);
+  return fromPcl(cloud);
+}
+
+Points loadXyz(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open");
+  Points out;
+  std::string line;
+  for (size_t number = 1; std::getline(in, line); ++number) {
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.erase(hash);
+    if (line.find_first_not_of(" \t\r,") == std::string::npos) continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream fields(line);
+    double x, y, z;
+    // Reading via strings lets "nan"/"inf" through to the finiteness check below.
+    std::string sx, sy, sz;
+    if (!(fields >> sx >> sy >> sz))
+      throw InputError(path + ":" + std::to_string(number) + ": expected 'x y z'");
+    try {
+      size_t px, py, pz;
+      x = std::stod(sx, &px); y = std::stod(sy, &py); z = std::stod(sz, &pz);
+      if (px != sx.size() || py != sy.size() || pz != sz.size()) throw std::invalid_argument("");
+    } catch (const std::exception&) {
+      throw InputError(path + ":" + std::to_string(number) + ": not a number in '" + line + "'");
+    }
+    out.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+  }
+  return out;
+}
+
+}  // namespace
+
+void validateMap(const Points& points, const std::string& what) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!points[i].allFinite()) {
+      const auto bad = std::count_if(points.begin(), points.end(),
+                                     [](const Eigen::Vector3f& p) { return !p.allFinite(); });
+      throw InputError(what + ": " + std::to_string(bad) + " of " + std::to_string(points.size()) +
+                       " points are NaN or infinite (first at index " + std::to_string(i) + ")");
+    }
+  }
+  if (points.empty()) throw InputError(what + ": map is empty");
+  if (points.size() < kMinMapPoints)
+    throw InputError(what + ": map has only " + std::to_string(points.size()) +
+                     " points; at least " + std::to_string(kMinMapPoints) + " are needed");
+}
+
+Points loadMap(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError(path + ": no such file");
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a directory, not a map file");
+  if (std::filesystem::file_size(path, ec) == 0) throw InputError(path + ": file is empty");
+
+  const std::string ext = lowerExtension(path);
+  Points points;
+  if (ext == ".pcd") points = loadPcl(path, false);
+  else if (ext == ".ply") points = loadPcl(path, true);
+  else if (ext == ".xyz" || ext == ".txt") points = loadXyz(path);
+  else throw InputError(path + ": unknown map format '" + ext + "' (use .pcd, .ply, .xyz or .txt)");
+  validateMap(points, path);
+  return points;
+}
+
+void savePcd(const std::string& path, const Points& points) {
+  silencePcl();
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  cloud.reserve(points.size());
+  for (const auto& p : points) cloud.push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+  if (cloud.empty() || pcl::io::savePCDFileBinaryCompressed(path, cloud) < 0)
+    throw InputError(path + ": cannot write map");
+}
+
+Eigen::Matrix4d loadPoseFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open pose file");
+  std::vector<double> v;
+  std::string token;
+  while (in >> token) {
+    try {
+      size_t used;
+      v.push_back(std::stod(token, &used));
+      if (used != token.size()) throw std::invalid_argument("");
+    } catch (const std::exception&) {
+      throw InputError(path + ": pose file has a non-number '" + token + "'");
+    }
+    if (!std::isfinite(v.back())) throw InputError(path + ": pose file has a non-finite number");
+  }
+  if (v.size() != 12)
+    throw InputError(path + ": pose file must hold 12 numbers (3x4 row-major), found " +
+                     std::to_string(v.size()));
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) m(r, c) = v[static_cast<size_t>(r * 4 + c)];
+  const Eigen::Matrix3d R = m.topLeftCorner<3, 3>();
+  if (!(R.transpose() * R).isIdentity(1e-3))
+    throw InputError(path + ": pose rotation is not orthonormal");
+  return m;
+}
+
+void savePoseFile(const std::string& path, const Eigen::Matrix4d& pose) {
+  std::ofstream out(path);
+  out << std::setprecision(17);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) out << pose(r, c) << (r == 2 && c == 3 ? "\n" : " ");
+  if (!out) throw InputError(path + ": cannot write pose file");
+}
+
+}  // namespace tomomap

@@ -1,0 +1,64 @@
+#pragma once
+// Height cross-correlation of two tomographic feature stacks (ALGORITHM.md sections 4-7).
+#include <functional>
+#include <string>
+
+#include "consensus.hpp"
+#include "features.hpp"
+#include "rigid2d.hpp"
+
+namespace tomomap {
+
+struct MatchParams {
+  double grid = 0.05;                  ///< voxel, pixel and slice size g [m]
+  FeatureParams features;
+  double ransac_threshold_cells = 3.0; ///< RANSAC inlier distance [grid cells]
+  int ransac_iterations = 2000;        ///< upper bound per slice pair
+  double ransac_confidence = 0.999;
+  int min_matches = 5;                 ///< fewer mutual matches: the slice pair gives no estimate
+  double consensus_translation_cells = 5.0;      ///< [grid cells]
+  double consensus_yaw = 10.0 * kPi / 180.0;     ///< [rad]
+  int min_support = 3;                 ///< agreeing slice pairs needed for a reliable match
+  int min_inliers = 20;                ///< inlier correspondences needed for a reliable match
+  int threads = 0;                     ///< 0 = all cores
+};
+
+/// Wall-clock seconds per stage.
+struct StageTimings {
+  double voxel = 0, slicing = 0, features = 0, pair_matching = 0, consensus = 0, refinement = 0;
+  double total() const { return voxel + slicing + features + pair_matching + consensus + refinement; }
+};
+
+struct MatchResult {
+  /// False means "no reliable match": T_target_source is then meaningless and
+  /// must not be used; `reason` says why.
+  bool reliable = false;
+  std::string reason;
+  Pose4 T_target_source;          ///< p_target = T_target_source * p_source
+
+  int support = 0;                ///< agreeing slice pairs at the winning height offset
+  int runner_up_support = 0;      ///< best support more than one step away from the winner
+  size_t inliers = 0;             ///< feature correspondences consistent with the result
+  Eigen::Vector3d inlier_spread = Eigen::Vector3d::Zero();  ///< std. dev. of inliers in target x, y, z [m]
+
+  int target_slices = 0, source_slices = 0;
+  size_t target_features = 0, source_features = 0;
+  size_t slice_pairs = 0;          ///< slice pairs matched (n_target x n_source with features)
+  StageTimings timings;
+};
+
+/// Called with (stage name, done, total) as work advances; may be empty.
+using Progress = std::function<void(const char*, size_t, size_t)>;
+
+/// Finds T_target_source from two feature stacks of the same grid size.
+MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source,
+                          const MatchParams& params, const Progress& progress = {});
+
+/// Voxel filter, slicing, features and matching for two raw maps.
+MatchResult matchMaps(const Points& target, const Points& source, const MatchParams& params,
+                      const Progress& progress = {});
+
+/// Voxel filter, slicing and features of one map, with the time each took.
+MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings = nullptr);
+
+}  // namespace tomomap

@@ -1,0 +1,65 @@
+#include "slices.hpp"
+
+#include <algorithm>
+
+namespace tomomap {
+
+cv::Mat SliceStack::image(int k, int pad) const {
+  cv::Mat img = cv::Mat::zeros(grid.height + 2 * pad, grid.width + 2 * pad, CV_8U);
+  for (uint32_t idx : cells[static_cast<size_t>(k)])
+    img.at<uint8_t>(static_cast<int>(idx) / grid.width + pad, static_cast<int>(idx) % grid.width + pad) = 255;
+  return img;
+}
+
+SliceStack makeSlices(const Points& points, double cell) {
+  if (!(cell > 0.0)) throw InputError("grid size must be positive");
+  SliceStack stack;
+  if (points.empty()) return stack;
+
+  Eigen::Vector3f lo = points.front(), hi = points.front();
+  for (const auto& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  SliceGrid& g = stack.grid;
+  g.cell = cell;
+  g.x_min = lo.x();
+  g.y_min = lo.y();
+  g.z_min = lo.z();
+  const double w = std::floor((hi.x() - lo.x()) / cell) + 1, h = std::floor((hi.y() - lo.y()) / cell) + 1;
+  const double n = std::ceil((hi.z() - lo.z()) / cell - 0.5) + 1;
+  if (w > kMaxImageSide || h > kMaxImageSide || n > kMaxImageSide)
+    throw InputError("grid size " + std::to_string(cell) + " m is too fine for a map of " +
+                     std::to_string(hi.x() - lo.x()) + " x " + std::to_string(hi.y() - lo.y()) + " x " +
+                     std::to_string(hi.z() - lo.z()) + " m (more than " + std::to_string(kMaxImageSide) +
+                     " cells along one axis)");
+  g.width = static_cast<int>(w);
+  g.height = static_cast<int>(h);
+
+  auto& cells = stack.cells;
+  cells.resize(static_cast<size_t>(n));
+  for (const auto& p : points) {
+    const int k = std::clamp(g.sliceIndex(p.z()), 0, static_cast<int>(n) - 1);
+    const int u = std::min(static_cast<int>((p.x() - g.x_min) / cell), g.width - 1);
+    const int v = std::min(static_cast<int>((p.y() - g.y_min) / cell), g.height - 1);
+    cells[static_cast<size_t>(k)].push_back(static_cast<uint32_t>(v * g.width + u));
+  }
+  const size_t min_cells = static_cast<size_t>(g.width + g.height);
+  for (auto& c : cells) {
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+    if (c.size() < min_cells) std::vector<uint32_t>().swap(c);
+  }
+
+  auto first = std::find_if(cells.begin(), cells.end(), [](const auto& c) { return !c.empty(); });
+  auto last = std::find_if(cells.rbegin(), cells.rend(), [](const auto& c) { return !c.empty(); }).base();
+  if (first >= last) {
+    cells.clear();
+    return stack;
+  }
+  g.z_min = g.sliceHeight(static_cast<int>(first - cells.begin()));
+  cells = std::vector<std::vector<uint32_t>>(std::make_move_iterator(first), std::make_move_iterator(last));
+  return stack;
+}
+
+}  // namespace tomomap

@@ -1,0 +1,48 @@
+#pragma once
+// Tomographic slicing: a map becomes a stack of horizontal binary occupancy images.
+#include <cstdint>
+#include <opencv2/core.hpp>
+
+#include "types.hpp"
+
+namespace tomomap {
+
+/// The raster every slice of one map shares.
+struct SliceGrid {
+  double cell = 0;                         ///< pixel size = grid size g [m]
+  double x_min = 0, y_min = 0, z_min = 0;  ///< map-frame position of pixel (0,0) and slice 0 [m]
+  int width = 0, height = 0;               ///< image size [pixels]
+
+  /// Height of slice k's centre [m].
+  double sliceHeight(int k) const { return z_min + k * cell; }
+  /// Slice index of height z: slice k holds h_k - g/2 < z <= h_k + g/2.
+  int sliceIndex(double z) const { return static_cast<int>(std::ceil((z - z_min) / cell - 0.5)); }
+  /// Map-frame x, y [m] of a (sub)pixel position; pixel centres are integers.
+  Eigen::Vector2f toMetres(float u, float v) const {
+    return {static_cast<float>(x_min + (u + 0.5) * cell), static_cast<float>(y_min + (v + 0.5) * cell)};
+  }
+};
+
+/// Occupied cells per slice, stored sparsely (pixel index v * width + u, sorted,
+/// unique) so that a tall map does not hold every image at once.
+struct SliceStack {
+  SliceGrid grid;
+  std::vector<std::vector<uint32_t>> cells;  ///< per slice; empty = too sparse to describe
+
+  int size() const { return static_cast<int>(cells.size()); }
+  /// Renders slice k as a CV_8U image, 255 = occupied, with `pad` empty pixels
+  /// around it (ORB finds no corners within its border distance).
+  cv::Mat image(int k, int pad = 0) const;
+};
+
+/// Largest image side accepted, so a tiny grid on a large map fails loudly
+/// instead of allocating gigabytes.
+constexpr int kMaxImageSide = 16384;
+
+/// Slices `points` (already voxel-filtered at `cell`). Slices with fewer
+/// occupied cells than width + height are kept empty (too sparse for ORB);
+/// empty slices at the bottom and top are trimmed. Throws InputError if the
+/// raster would exceed kMaxImageSide.
+SliceStack makeSlices(const Points& points, double cell);
+
+}  // namespace tomomap
