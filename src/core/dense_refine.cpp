@@ -7,24 +7,35 @@ namespace {
 
 /// One slice pair: the target's occupancy image and the source's cell centres.
 struct PairCells {
-  cv::Mat target;                       // CV_8U, 255 = occupied
+  cv::Mat target;                       // CV_8U, 255 = occupied (shared, not copied)
   std::vector<Eigen::Vector2d> source;  // source cell centres [m]
 };
 
-std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& source, int offset) {
-  std::vector<PairCells> pairs;
+std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& source, int offset,
+                                    size_t max_cells) {
+  size_t total = 0;
   for (int i = 0; i < target.size(); ++i) {
-    if (target.cells[static_cast<size_t>(i)].empty()) continue;
-    for (int j = i - offset - 1; j <= i - offset + 1; ++j) {
-      if (j < 0 || j >= source.size() || source.cells[static_cast<size_t>(j)].empty()) continue;
-      PairCells p{target.image(i), {}};
-      const auto& g = source.grid;
-      for (uint32_t idx : source.cells[static_cast<size_t>(j)])
-        p.source.push_back(g.toMetres(static_cast<float>(idx % static_cast<uint32_t>(g.width)),
-                                      static_cast<float>(idx / static_cast<uint32_t>(g.width)))
-                               .cast<double>());
-      pairs.push_back(std::move(p));
-    }
+    const int j = i - offset;
+    if (!target.cells[static_cast<size_t>(i)].empty() && j >= 0 && j < source.size())
+      total += source.cells[static_cast<size_t>(j)].size();
+  }
+  // Thinning the source cells evenly keeps the cost bounded on large maps; a few
+  // tens of thousands of cells already average the quantisation out.
+  const size_t stride = std::max<size_t>(1, (total + max_cells - 1) / max_cells);
+  std::vector<PairCells> pairs;
+  const auto& g = source.grid;
+  for (int i = 0; i < target.size(); ++i) {
+    const int j = i - offset;
+    if (target.cells[static_cast<size_t>(i)].empty() || j < 0 || j >= source.size() ||
+        source.cells[static_cast<size_t>(j)].empty())
+      continue;
+    PairCells p{target.image(i), {}};
+    const auto& cells = source.cells[static_cast<size_t>(j)];
+    for (size_t k = 0; k < cells.size(); k += stride)
+      p.source.push_back(g.toMetres(static_cast<float>(cells[k] % static_cast<uint32_t>(g.width)),
+                                    static_cast<float>(cells[k] / static_cast<uint32_t>(g.width)))
+                             .cast<double>());
+    pairs.push_back(std::move(p));
   }
   return pairs;
 }
@@ -34,7 +45,7 @@ std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& 
 DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& source, int offset,
                                     const Rigid2D& initial, const DenseRefineParams& params) {
   DenseRefineResult result{initial, 0};
-  const std::vector<PairCells> pairs = collectPairs(target, source, offset);
+  const std::vector<PairCells> pairs = collectPairs(target, source, offset, params.max_cells);
   if (pairs.empty()) return result;
   const auto& tg = target.grid;
   const double cell = tg.cell;
@@ -71,8 +82,11 @@ DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& 
         }
       }
       if (c.size() < 3) return result;
-      result.transform = fitRigid2D(c);
+      const Rigid2D next = fitRigid2D(c);
+      const bool converged = (next.t - T.t).norm() < 1e-4 * cell && std::abs(wrapAngle(next.yaw - T.yaw)) < 1e-6;
+      result.transform = next;
       result.correspondences = c.size();
+      if (converged) break;
     }
   }
   return result;

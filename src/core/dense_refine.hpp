@@ -6,8 +6,9 @@
 namespace tomomap {
 
 struct DenseRefineParams {
-  std::vector<double> radii_cells{3.0, 2.0, 1.5};  ///< correspondence radius per stage [grid cells]
-  int iterations_per_stage = 8;
+  std::vector<double> radii_cells{3.0, 1.5};  ///< correspondence radius per stage [grid cells]
+  int iterations_per_stage = 10;              ///< upper bound; stops earlier once converged
+  size_t max_cells = 40000;                   ///< source cells used at most (evenly thinned)
 };
 
 struct DenseRefineResult {
@@ -18,8 +19,8 @@ struct DenseRefineResult {
 /// Feature keypoints sit on whole pixels and vertical structures repeat the same
 /// keypoint in many slices, so the feature fit alone leaves a yaw error of a few
 /// milliradians: 0.2 m at 50 m from the origin. This ICP over every occupied cell
-/// of the slice pairs at `offset` (target index - source index) and its two
-/// neighbours averages the pixel quantisation out over thousands of cells.
+/// of the slice pairs at `offset` (target index - source index) averages the
+/// pixel quantisation out over thousands of cells.
 DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& source, int offset,
                                     const Rigid2D& initial, const DenseRefineParams& params = {});
 

@@ -6,9 +6,9 @@
 #include <atomic>
 #include <chrono>
 #include <map>
-#include <opencv2/features2d.hpp>
 
 #include "dense_refine.hpp"
+#include "hamming.hpp"
 #include "map_io.hpp"
 #include "voxel_filter.hpp"
 
@@ -22,14 +22,13 @@ double secondsSince(Clock::time_point t0) {
 
 /// Mutual nearest neighbours in Hamming distance, as source -> target positions.
 Correspondences mutualMatches(const SliceFeatures& target, const SliceFeatures& source) {
-  std::vector<cv::DMatch> matches;
-  cv::BFMatcher(cv::NORM_HAMMING, /*crossCheck=*/true).match(source.descriptors, target.descriptors, matches);
+  const auto matches = mutualNearest(source.descriptors, target.descriptors);
   Correspondences c;
   c.source.reserve(matches.size());
   c.target.reserve(matches.size());
-  for (const auto& m : matches) {
-    c.source.push_back(source.keypoints[static_cast<size_t>(m.queryIdx)].cast<double>());
-    c.target.push_back(target.keypoints[static_cast<size_t>(m.trainIdx)].cast<double>());
+  for (const auto& [s, t] : matches) {
+    c.source.push_back(source.keypoints[static_cast<size_t>(s)].cast<double>());
+    c.target.push_back(target.keypoints[static_cast<size_t>(t)].cast<double>());
   }
   return c;
 }
