@@ -1,4 +1,5 @@
 #include "map_io.hpp"
+#include "pcd_check.hpp"
 
 #include <pcl/common/io.h>
 #include <pcl/console/print.h>
@@ -35,6 +36,7 @@ Points fromPcl(const pcl::PointCloud<pcl::PointXYZ>& cloud) {
 
 Points loadPcl(const std::string& path, bool ply) {
   silencePcl();
+  if (!ply) checkPcdIntegrity(path);
   pcl::PCLPointCloud2 blob;
   const int rc = ply ? pcl::io::loadPLYFile(path, blob) : pcl::io::loadPCDFile(path, blob);
   if (rc < 0) throw InputError(path + ": not a readable " + (ply ? "PLY" : "PCD") + " file (corrupt or truncated)");

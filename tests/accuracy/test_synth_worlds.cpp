@@ -1,0 +1,44 @@
+// Success rate on generated worlds at the paper's two noise levels.
+#include <gtest/gtest.h>
+
+#include "core/matcher.hpp"
+#include "synth/synth.hpp"
+
+using namespace tomomap;
+using namespace tomomap::synth;
+
+struct WorldCase {
+  WorldType type;
+  const char* noise;
+};
+
+class SynthAccuracy : public ::testing::TestWithParam<WorldCase> {};
+
+TEST_P(SynthAccuracy, AtLeastNineOfTenSeedsSucceed) {
+  const WorldCase wc = GetParam();
+  int successes = 0;
+  for (uint64_t seed = 1; seed <= 10; ++seed) {
+    SceneParams sp;
+    sp.type = wc.type;
+    sp.seed = seed;
+    const Scene scene = makeScene(sp);
+    const auto maps = scanScene(scene, noiseLevel(wc.noise), seed);
+    MatchParams mp;
+    mp.grid = scene.grid;
+    const MatchResult r = matchMaps(maps[0].points, maps[1].points, mp);
+    const Pose4 truth = Pose4::fromMatrix(maps[0].pose * maps[1].pose.inverse());
+    const PoseError e = poseError(r.T_target_source, truth);
+    // The paper's rule: translation below 5 grid cells and yaw below 10 degrees.
+    const bool ok = r.reliable && e.translation < 5 * scene.grid && e.yaw < 10 * kPi / 180;
+    successes += ok;
+    std::cout << toString(wc.type) << " " << wc.noise << " seed " << seed << ": "
+              << (r.reliable ? "" : "no reliable match, ") << "translation error " << e.translation
+              << " m, yaw error " << e.yaw << " rad, " << r.timings.total() << " s" << (ok ? "" : "  FAILED") << "\n";
+  }
+  EXPECT_GE(successes, 9);
+}
+
+INSTANTIATE_TEST_SUITE_P(Worlds, SynthAccuracy,
+                         ::testing::Values(WorldCase{WorldType::Indoor, "low"}, WorldCase{WorldType::Indoor, "high"},
+                                           WorldCase{WorldType::Outdoor, "low"}, WorldCase{WorldType::Outdoor, "high"}),
+                         [](const auto& p) { return toString(p.param.type) + "_" + p.param.noise; });

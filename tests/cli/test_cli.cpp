@@ -1,0 +1,156 @@
+// The `tomomap` binary as a user runs it: exit codes, messages, files.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "support.hpp"
+
+using namespace tomomap;
+using tomomap::test::runTomomap;
+using tomomap::test::TempDir;
+
+namespace {
+
+std::string demo(const std::string& f) { return test::demoRoom() + "/" + f; }
+std::string demoMatchArgs() {
+  return "match " + demo("demo-pcd1.pcd") + " " + demo("demo-pcd2.pcd") + " --gt-target " + demo("demo-pcd1-gtpose.txt") +
+         " --gt-source " + demo("demo-pcd2-gtpose.txt");
+}
+
+size_t lines(const std::string& s) { return static_cast<size_t>(std::count(s.begin(), s.end(), '\n')); }
+
+/// A bad-input run: exit code 2, one line naming `what`, and no transform printed.
+void expectBadInput(const test::CommandResult& r, const std::string& what) {
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(what), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("T_target_source"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("Segmentation"), std::string::npos);
+}
+
+}  // namespace
+
+TEST(Cli, HelpAndVersion) {
+  const auto help = runTomomap("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.output.find("match"), std::string::npos);
+  EXPECT_NE(help.output.find("synth"), std::string::npos);
+  EXPECT_NE(help.output.find("Exit codes"), std::string::npos);
+  const auto version = runTomomap("--version");
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_NE(version.output.find("tomomap 0."), std::string::npos);
+  EXPECT_EQ(runTomomap("match --help").exit_code, 0);
+  EXPECT_EQ(runTomomap("").exit_code, 2);            // no subcommand
+  EXPECT_EQ(runTomomap("frobnicate").exit_code, 2);  // unknown subcommand
+}
+
+TEST(Cli, MatchDemoRoomPrintsTransformErrorAndJson) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  const auto r = runTomomap(demoMatchArgs() + " --json " + (dir / "r.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("T_target_source"), std::string::npos);
+  EXPECT_NE(r.output.find("ground truth"), std::string::npos);
+  EXPECT_NE(r.output.find(": success"), std::string::npos);
+  std::ifstream in(dir / "r.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_TRUE(j["reliable"].get<bool>());
+  EXPECT_NEAR(j["T_target_source"]["x"].get<double>(), 0.978, 0.05);
+  EXPECT_NEAR(j["T_target_source"]["yaw"].get<double>(), -3.087, 0.02);
+  EXPECT_EQ(j["T_target_source"]["matrix"].size(), 4u);
+  EXPECT_TRUE(j["error"]["success"].get<bool>());
+  EXPECT_GT(j["quality"]["support"].get<int>(), 3);
+}
+
+TEST(Cli, MissingFile) { expectBadInput(runTomomap("match /nonexistent/a.pcd /nonexistent/b.pcd"), "no such file"); }
+
+TEST(Cli, EmptyTinyNanTruncatedAndCorruptMaps) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  const std::string good = demo("demo-pcd1.pcd");
+  std::ofstream(dir / "empty.pcd").flush();
+  std::string ten, nan;
+  for (int i = 0; i < 10; ++i) ten += std::to_string(i) + " 0 1\n";
+  for (int i = 0; i < 500; ++i) nan += std::to_string(i % 23) + " " + std::to_string(i / 23) + " 1\n";
+  std::ofstream(dir / "ten.xyz") << ten;
+  std::ofstream(dir / "nan.xyz") << nan << "nan 0 0\n";
+  std::ofstream(dir / "inf.xyz") << nan << "1 -inf 0\n";
+  std::ifstream in(good, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  std::ofstream(dir / "cut.pcd", std::ios::binary) << bytes.substr(0, bytes.size() / 3);
+  std::string corrupt = bytes;
+  corrupt.replace(corrupt.find("FIELDS"), 6, "FIELXS");
+  std::ofstream(dir / "corrupt.pcd", std::ios::binary) << corrupt;
+
+  expectBadInput(runTomomap("match " + good + " " + (dir / "empty.pcd")), "empty");
+  expectBadInput(runTomomap("match " + good + " " + (dir / "ten.xyz")), "only 10 points");
+  expectBadInput(runTomomap("match " + good + " " + (dir / "nan.xyz")), "NaN or infinite");
+  expectBadInput(runTomomap("match " + good + " " + (dir / "inf.xyz")), "NaN or infinite");
+  expectBadInput(runTomomap("match " + good + " " + (dir / "cut.pcd")), "cut.pcd");
+  expectBadInput(runTomomap("match " + good + " " + (dir / "corrupt.pcd")), "corrupt.pcd");
+  // One line of diagnosis, not a dump.
+  EXPECT_EQ(lines(runTomomap("match " + good + " " + (dir / "cut.pcd")).output), 1u);
+}
+
+TEST(Cli, BadGridValues) {
+  REQUIRE_DEMO_ROOM();
+  const std::string maps = " " + demo("demo-pcd1.pcd") + " " + demo("demo-pcd2.pcd");
+  expectBadInput(runTomomap("match" + maps + " --grid 0"), "--grid");
+  expectBadInput(runTomomap("match" + maps + " --grid -0.05"), "--grid");
+  expectBadInput(runTomomap("match" + maps + " --grid abc"), "--grid");
+  expectBadInput(runTomomap("match" + maps + " --grid 0.00001"), "too fine");
+}
+
+TEST(Cli, BadPoseFile) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  std::ofstream(dir / "pose.txt") << "1 2 3\n";
+  expectBadInput(runTomomap("match " + demo("demo-pcd1.pcd") + " " + demo("demo-pcd2.pcd") + " --gt-target " +
+                            (dir / "pose.txt") + " --gt-source " + demo("demo-pcd2-gtpose.txt")),
+                 "12 numbers");
+}
+
+TEST(Cli, NoReliableMatchExitsOneWithoutTransform) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  // A map of scattered noise shares nothing with the room.
+  std::ofstream out(dir / "noise.xyz");
+  uint32_t s = 12345;
+  for (int i = 0; i < 30000; ++i) {
+    auto next = [&s] { return (s = s * 1664525u + 1013904223u) / 4294967296.0; };
+    out << 6 * next() << " " << 6 * next() << " " << 3 * next() << "\n";
+  }
+  out.close();
+  const auto r = runTomomap("match " + demo("demo-pcd1.pcd") + " " + (dir / "noise.xyz") + " --json " + (dir / "r.json"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("no reliable match"), std::string::npos);
+  EXPECT_EQ(r.output.find("T_target_source"), std::string::npos);
+  std::ifstream in(dir / "r.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_FALSE(j["reliable"].get<bool>());
+  EXPECT_FALSE(j.contains("T_target_source"));
+}
+
+TEST(Cli, SynthThenMatchOnAFreshMachine) {
+  TempDir dir;
+  const auto s = runTomomap("synth --world outdoor --seed 3 --out " + (dir / "w"));
+  ASSERT_EQ(s.exit_code, 0) << s.output;
+  const auto again = runTomomap("synth --world outdoor --seed 3 --out " + (dir / "w2"));
+  ASSERT_EQ(again.exit_code, 0);
+  std::ifstream a(dir / "w/map_1.pcd", std::ios::binary), b(dir / "w2/map_1.pcd", std::ios::binary);
+  EXPECT_TRUE(std::equal(std::istreambuf_iterator<char>(a), {}, std::istreambuf_iterator<char>(b)))
+      << "same seed must give the same map";
+  const std::string w = dir / "w";
+  const auto m = runTomomap("match " + w + "/map_0.pcd " + w + "/map_1.pcd --grid 0.2 --gt-target " + w +
+                            "/map_0-gtpose.txt --gt-source " + w + "/map_1-gtpose.txt");
+  EXPECT_EQ(m.exit_code, 0) << m.output;
+  EXPECT_NE(m.output.find(": success"), std::string::npos) << m.output;
+}
+
+TEST(Cli, SynthRejectsBadOptions) {
+  TempDir dir;
+  expectBadInput(runTomomap("synth --world forest --out " + (dir / "x")), "--world");
+  expectBadInput(runTomomap("synth --noise extreme --out " + (dir / "x")), "--noise");
+  expectBadInput(runTomomap("synth --maps 0 --out " + (dir / "x")), "--maps");
+  EXPECT_EQ(runTomomap("synth").exit_code, 2);  // --out is required
+}

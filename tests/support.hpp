@@ -1,0 +1,69 @@
+#pragma once
+// Helpers shared by the test programs: data paths, temporary directories, running the CLI.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include "core/map_io.hpp"
+
+namespace tomomap::test {
+
+inline std::string demoRoom() { return TOMOMAP_DEMO_ROOM; }
+inline bool haveDemoRoom() { return std::filesystem::exists(demoRoom() + "/demo-pcd1.pcd"); }
+
+#define REQUIRE_DEMO_ROOM() \
+  if (!::tomomap::test::haveDemoRoom()) GTEST_SKIP() << "demo-room data set not found at " << ::tomomap::test::demoRoom()
+
+/// A fresh directory removed when the object goes out of scope.
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() {
+    std::random_device rd;
+    path = std::filesystem::temp_directory_path() / ("tomomap-test-" + std::to_string(rd()) + std::to_string(rd()));
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  std::string operator/(const std::string& name) const { return (path / name).string(); }
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  ///< stdout and stderr together
+};
+
+/// Runs the tomomap binary with `args` (shell syntax) and captures its output.
+inline CommandResult runTomomap(const std::string& args) {
+  CommandResult r;
+  const std::string cmd = std::string(TOMOMAP_BIN) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.output.append(buf.data(), n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+/// Demo-room maps and the expected T_1_2 (target pcd1, source pcd2).
+struct DemoPair {
+  Points map1, map2;
+  Pose4 T_1_2;
+};
+
+inline DemoPair loadDemoPair() {
+  const std::string d = demoRoom() + "/";
+  DemoPair p{loadMap(d + "demo-pcd1.pcd"), loadMap(d + "demo-pcd2.pcd"), {}};
+  p.T_1_2 = Pose4::fromMatrix(loadPoseFile(d + "demo-pcd1-gtpose.txt") *
+                              loadPoseFile(d + "demo-pcd2-gtpose.txt").inverse());
+  return p;
+}
+
+}  // namespace tomomap::test

@@ -1,0 +1,41 @@
+#include <gtest/gtest.h>
+
+#include <opencv2/core.hpp>
+#include <random>
+
+#include "core/hamming.hpp"
+
+using namespace tomomap;
+
+static int hamming(const cv::Mat& a, int i, const cv::Mat& b, int j) {
+  return static_cast<int>(cv::norm(a.row(i), b.row(j), cv::NORM_HAMMING));
+}
+
+TEST(Hamming, MutualNearestMatchesBruteForce) {
+  cv::RNG rng(7);
+  cv::Mat a(300, 32, CV_8U), b(250, 32, CV_8U);
+  rng.fill(a, cv::RNG::UNIFORM, 0, 256);
+  rng.fill(b, cv::RNG::UNIFORM, 0, 256);
+  a.rowRange(0, 100).copyTo(b.rowRange(50, 150));  // 100 exact pairs
+  // Reference: the first-lowest nearest neighbour each way, via OpenCV's norm.
+  std::vector<std::pair<int, int>> expected;
+  for (int i = 0; i < a.rows; ++i) {
+    int bj = 0;
+    for (int j = 1; j < b.rows; ++j)
+      if (hamming(a, i, b, j) < hamming(a, i, b, bj)) bj = j;
+    int bi = 0;
+    for (int k = 1; k < a.rows; ++k)
+      if (hamming(a, k, b, bj) < hamming(a, bi, b, bj)) bi = k;
+    if (bi == i) expected.emplace_back(i, bj);
+  }
+  const auto got = mutualNearest(a, b);
+  EXPECT_EQ(got, expected);
+  for (int i = 0; i < 100; ++i)
+    EXPECT_NE(std::find(got.begin(), got.end(), std::make_pair(i, i + 50)), got.end());
+}
+
+TEST(Hamming, EmptySetsGiveNoMatches) {
+  cv::Mat a(5, 32, CV_8U, cv::Scalar(1));
+  EXPECT_TRUE(mutualNearest(a, cv::Mat()).empty());
+  EXPECT_TRUE(mutualNearest(cv::Mat(), a).empty());
+}

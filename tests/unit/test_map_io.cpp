@@ -1,0 +1,136 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "core/map_io.hpp"
+#include "support.hpp"
+
+using namespace tomomap;
+using tomomap::test::TempDir;
+
+static Points grid(int n) {
+  Points p;
+  for (int i = 0; i < n; ++i) p.emplace_back(0.1f * static_cast<float>(i % 20), 0.1f * static_cast<float>(i / 20), 0.01f * static_cast<float>(i));
+  return p;
+}
+
+static void write(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+static std::string pcdHeader(size_t n, const std::string& data) {
+  return "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " + std::to_string(n) +
+         "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(n) + "\nDATA " + data + "\n";
+}
+
+/// Message of the InputError `f` throws, or "" if it throws none.
+template <typename F>
+static std::string errorOf(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(MapIo, RoundTripsBinaryCompressedPcd) {
+  TempDir dir;
+  const Points p = grid(500);
+  savePcd(dir / "m.pcd", p);
+  const Points q = loadMap(dir / "m.pcd");
+  ASSERT_EQ(q.size(), p.size());
+  EXPECT_EQ(q[123], p[123]);
+}
+
+TEST(MapIo, ReadsAsciiPcdPlyAndXyz) {
+  TempDir dir;
+  std::string pcd = pcdHeader(200, "ascii"), ply, xyz = "# x y z\n";
+  ply = "ply\nformat ascii 1.0\nelement vertex 200\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  for (const auto& q : grid(200)) {
+    const std::string line = std::to_string(q.x()) + " " + std::to_string(q.y()) + " " + std::to_string(q.z()) + "\n";
+    pcd += line;
+    ply += line;
+    xyz += line;
+  }
+  write(dir / "a.pcd", pcd);
+  write(dir / "a.ply", ply);
+  write(dir / "a.xyz", xyz);
+  for (const char* f : {"a.pcd", "a.ply", "a.xyz"}) {
+    const Points q = loadMap(dir / f);
+    ASSERT_EQ(q.size(), 200u) << f;
+    EXPECT_NEAR(q[199].z(), 1.99f, 1e-5) << f;
+  }
+}
+
+TEST(MapIo, MissingFileIsNamed) {
+  EXPECT_NE(errorOf([] { loadMap("/nonexistent/map.pcd"); }).find("no such file"), std::string::npos);
+}
+
+TEST(MapIo, EmptyFileAndEmptyMapAreRejected) {
+  TempDir dir;
+  write(dir / "empty.pcd", "");
+  EXPECT_NE(errorOf([&] { loadMap(dir / "empty.pcd"); }).find("empty"), std::string::npos);
+  write(dir / "nopoints.pcd", pcdHeader(0, "ascii"));
+  EXPECT_NE(errorOf([&] { loadMap(dir / "nopoints.pcd"); }), "");
+}
+
+TEST(MapIo, TinyMapIsRejected) {
+  TempDir dir;
+  savePcd(dir / "ten.pcd", grid(10));
+  EXPECT_NE(errorOf([&] { loadMap(dir / "ten.pcd"); }).find("only 10 points"), std::string::npos);
+}
+
+TEST(MapIo, NonFinitePointsAreRejected) {
+  TempDir dir;
+  std::string xyz;
+  for (const auto& q : grid(200)) xyz += std::to_string(q.x()) + " " + std::to_string(q.y()) + " " + std::to_string(q.z()) + "\n";
+  write(dir / "nan.xyz", xyz + "nan 1 2\ninf 0 0\n");
+  EXPECT_NE(errorOf([&] { loadMap(dir / "nan.xyz"); }).find("2 of 202 points are NaN or infinite"), std::string::npos);
+  Points p = grid(200);
+  p[7].y() = std::numeric_limits<float>::quiet_NaN();
+  savePcd(dir / "nan.pcd", p);
+  EXPECT_NE(errorOf([&] { loadMap(dir / "nan.pcd"); }).find("NaN"), std::string::npos);
+}
+
+TEST(MapIo, TruncatedAndCorruptPcdAreRejected) {
+  TempDir dir;
+  savePcd(dir / "good.pcd", grid(5000));
+  std::ifstream in(dir / "good.pcd", std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  std::ofstream(dir / "cut.pcd", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  EXPECT_NE(errorOf([&] { loadMap(dir / "cut.pcd"); }), "");
+
+  std::string garbled = bytes;
+  for (size_t i = garbled.find("DATA") + 30; i < garbled.size(); i += 7) garbled[i] = static_cast<char>(0xA5);
+  std::ofstream(dir / "garbled.pcd", std::ios::binary) << garbled;
+  EXPECT_NE(errorOf([&] { loadMap(dir / "garbled.pcd"); }), "");
+
+  write(dir / "text.pcd", "this is not a point cloud\n");
+  EXPECT_NE(errorOf([&] { loadMap(dir / "text.pcd"); }), "");
+  write(dir / "short.pcd", pcdHeader(300, "ascii") + "1 2 3\n4 5 6\n");
+  EXPECT_NE(errorOf([&] { loadMap(dir / "short.pcd"); }), "");
+}
+
+TEST(MapIo, BadXyzLineIsNamed) {
+  TempDir dir;
+  write(dir / "bad.xyz", "1 2 3\n4 five 6\n");
+  EXPECT_NE(errorOf([&] { loadMap(dir / "bad.xyz"); }).find("bad.xyz:2"), std::string::npos);
+}
+
+TEST(MapIo, UnknownExtensionIsRejected) {
+  TempDir dir;
+  write(dir / "map.las", "x");
+  EXPECT_NE(errorOf([&] { loadMap(dir / "map.las"); }).find("unknown map format"), std::string::npos);
+}
+
+TEST(PoseIo, RoundTripsAndRejectsBadFiles) {
+  TempDir dir;
+  const Eigen::Matrix4d P = Pose4{1.5, -2, 0.3, 2.9}.matrix();
+  savePoseFile(dir / "p.txt", P);
+  EXPECT_TRUE(loadPoseFile(dir / "p.txt").isApprox(P, 1e-12));
+  write(dir / "short.txt", "1 0 0 0 0 1 0 0 0 0 1\n");
+  EXPECT_NE(errorOf([&] { loadPoseFile(dir / "short.txt"); }).find("12 numbers"), std::string::npos);
+  write(dir / "word.txt", "1 0 0 0 0 1 0 0 0 0 1 x\n");
+  EXPECT_NE(errorOf([&] { loadPoseFile(dir / "word.txt"); }).find("non-number"), std::string::npos);
+  write(dir / "skew.txt", "2 0 0 0 0 1 0 0 0 0 1 0\n");
+  EXPECT_NE(errorOf([&] { loadPoseFile(dir / "skew.txt"); }).find("orthonormal"), std::string::npos);
+}

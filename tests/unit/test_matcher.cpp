@@ -1,0 +1,79 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/matcher.hpp"
+#include "support.hpp"
+
+using namespace tomomap;
+
+TEST(Matcher, OppositeDirectionsGiveMutuallyInverseTransforms) {
+  REQUIRE_DEMO_ROOM();
+  const auto demo = test::loadDemoPair();
+  const MatchParams p;
+  const MatchResult ab = matchMaps(demo.map1, demo.map2, p), ba = matchMaps(demo.map2, demo.map1, p);
+  ASSERT_TRUE(ab.reliable && ba.reliable);
+  const PoseError e = poseError(ab.T_target_source * ba.T_target_source, Pose4{});
+  EXPECT_LT(e.translation, 0.05);
+  EXPECT_LT(e.yaw, 0.01);
+}
+
+TEST(Matcher, ParallelRunEqualsSerialRun) {
+  REQUIRE_DEMO_ROOM();
+  const auto demo = test::loadDemoPair();
+  MatchParams serial, parallel;
+  serial.threads = 1;
+  parallel.threads = 2;
+  const MatchResult a = matchMaps(demo.map1, demo.map2, serial), b = matchMaps(demo.map1, demo.map2, parallel);
+  EXPECT_EQ(a.T_target_source.x, b.T_target_source.x);
+  EXPECT_EQ(a.T_target_source.yaw, b.T_target_source.yaw);
+  EXPECT_EQ(a.support, b.support);
+  EXPECT_EQ(a.inliers, b.inliers);
+}
+
+TEST(Matcher, ReportsQualityAndTimings) {
+  REQUIRE_DEMO_ROOM();
+  const auto demo = test::loadDemoPair();
+  const MatchResult r = matchMaps(demo.map1, demo.map2, MatchParams{});
+  ASSERT_TRUE(r.reliable);
+  EXPECT_GT(r.support, r.runner_up_support);
+  EXPECT_GE(r.inliers, 100u);
+  EXPECT_GT(r.inlier_spread.x(), 0.5);  // inliers spread over the room, not one corner
+  EXPECT_GT(r.inlier_spread.z(), 0.3);
+  EXPECT_GT(r.slice_pairs, 1000u);  // slices with features, all against all
+  EXPECT_LE(r.slice_pairs, static_cast<size_t>(r.target_slices) * r.source_slices);
+  EXPECT_GT(r.timings.pair_matching, 0.0);
+}
+
+TEST(Matcher, UnrelatedNoiseIsNoReliableMatch) {
+  REQUIRE_DEMO_ROOM();
+  const auto demo = test::loadDemoPair();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.f, 6.f);
+  Points noise;
+  for (int i = 0; i < 60000; ++i) noise.emplace_back(u(rng), u(rng), u(rng) / 2);
+  const MatchResult r = matchMaps(demo.map1, noise, MatchParams{});
+  EXPECT_FALSE(r.reliable);
+  EXPECT_FALSE(r.reason.empty());
+}
+
+TEST(Matcher, FlatMapIsNoReliableMatch) {
+  Points flat;
+  for (int i = 0; i < 100; ++i)
+    for (int j = 0; j < 100; ++j) flat.emplace_back(0.05f * static_cast<float>(i), 0.05f * static_cast<float>(j * (1 + (i % 7 == 0))), 0.f);
+  const MatchResult r = matchMaps(flat, flat, MatchParams{});
+  EXPECT_FALSE(r.reliable);
+  EXPECT_NE(r.reason.find("too few descriptive slices"), std::string::npos);
+}
+
+TEST(Matcher, BadInputThrows) {
+  Points tiny{{0, 0, 0}, {1, 1, 1}};
+  EXPECT_THROW(matchMaps(tiny, tiny, MatchParams{}), InputError);
+  MatchParams zero;
+  zero.grid = 0;
+  EXPECT_THROW(matchMaps(tiny, tiny, zero), InputError);
+  MapFeatures a, b;
+  a.grid = 0.05;
+  b.grid = 0.1;
+  EXPECT_THROW(matchFeatures(a, b, MatchParams{}), InputError);
+}

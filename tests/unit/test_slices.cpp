@@ -1,0 +1,81 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/slices.hpp"
+
+using namespace tomomap;
+
+TEST(Slices, EveryPointLandsInExactlyOneSlice) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-5.f, 5.f);
+  SliceGrid g;
+  g.cell = 0.05;
+  g.z_min = -5.0;
+  for (int i = 0; i < 100000; ++i) {
+    const double z = u(rng);
+    int owners = 0;
+    for (int k = g.sliceIndex(z) - 2; k <= g.sliceIndex(z) + 2; ++k)
+      owners += (g.sliceHeight(k) - g.cell / 2 < z && z <= g.sliceHeight(k) + g.cell / 2);
+    ASSERT_EQ(owners, 1) << "z = " << z;
+    const int k = g.sliceIndex(z);
+    ASSERT_GT(z, g.sliceHeight(k) - g.cell / 2 - 1e-9);
+    ASSERT_LE(z, g.sliceHeight(k) + g.cell / 2 + 1e-9);
+  }
+}
+
+TEST(Slices, BoundaryBelongsToTheLowerSlice) {
+  SliceGrid g;
+  g.cell = 0.5;  // exactly representable, so the boundary is exact
+  g.z_min = 0.0;
+  EXPECT_EQ(g.sliceIndex(0.25), 0);  // h_0 + g/2 is in slice 0 ...
+  EXPECT_EQ(g.sliceIndex(0.2500001), 1);  // ... and just above it is slice 1
+  EXPECT_EQ(g.sliceIndex(-0.25), -1);
+}
+
+/// A box-shaped room: floor, four walls, ceiling, sampled every `step`.
+static Points room(double step) {
+  Points p;
+  for (double x = 0; x <= 4; x += step)
+    for (double y = 0; y <= 3; y += step) {
+      p.emplace_back(x, y, 0);
+      p.emplace_back(x, y, 2.5);
+    }
+  for (double z = 0; z <= 2.5; z += step) {
+    for (double x = 0; x <= 4; x += step) {
+      p.emplace_back(x, 0, z);
+      p.emplace_back(x, 3, z);
+    }
+    for (double y = 0; y <= 3; y += step) {
+      p.emplace_back(0, y, z);
+      p.emplace_back(4, y, z);
+    }
+  }
+  return p;
+}
+
+TEST(Slices, StackCoversTheMapAndKeepsAllOccupiedCells) {
+  const Points pts = room(0.05);
+  const SliceStack s = makeSlices(pts, 0.1);
+  EXPECT_EQ(s.grid.width, 41);
+  EXPECT_EQ(s.grid.height, 31);
+  EXPECT_EQ(s.size(), 26);  // 0 .. 2.5 m in 0.1 m steps
+  // Wall slices hold the room's outline: 2 * (41 + 31) - 4 cells, more than width + height.
+  EXPECT_EQ(s.cells[10].size(), 2u * (41 + 31) - 4);
+  EXPECT_EQ(cv::countNonZero(s.image(10)), static_cast<int>(s.cells[10].size()));
+  EXPECT_EQ(s.image(10, 5).cols, 41 + 10);
+}
+
+TEST(Slices, SparseSlicesAreEmptiedAndEndsTrimmed) {
+  Points pts = room(0.05);
+  pts.emplace_back(1.0f, 1.0f, 4.0f);  // a lone point far above: too sparse to describe
+  const SliceStack s = makeSlices(pts, 0.1);
+  EXPECT_EQ(s.size(), 26);  // the lone point's slice was trimmed away with the gap
+}
+
+TEST(Slices, TooFineGridFailsLoudly) {
+  const Points pts{{0, 0, 0}, {1000, 1000, 1}};
+  EXPECT_THROW(makeSlices(pts, 0.01), InputError);
+}
+
+TEST(Slices, EmptyMapGivesEmptyStack) { EXPECT_EQ(makeSlices({}, 0.1).size(), 0); }

@@ -1,0 +1,91 @@
+#include <gtest/gtest.h>
+
+#include <set>
+#include <tuple>
+
+#include "synth/synth.hpp"
+
+using namespace tomomap;
+using namespace tomomap::synth;
+
+TEST(World, RayHitsTheNearestSolid) {
+  World w;
+  w.boxes.push_back({{5, -1, -1}, {6, 1, 1}});
+  w.boxes.push_back({{3, -1, -1}, {3.5, 1, 1}});
+  w.cylinders.push_back({{0, 8}, 0.5, -1, 1});
+  const Eigen::Vector3d o(0, 0, 0);
+  const auto near = solidsNear(w, o, 20);
+  EXPECT_NEAR(castRay(w, near, o, {1, 0, 0}, 20), 3.0, 1e-9);
+  EXPECT_NEAR(castRay(w, near, o, {0, 1, 0}, 20), 7.5, 1e-9);
+  EXPECT_TRUE(std::isinf(castRay(w, near, o, {-1, 0, 0}, 20)));
+  EXPECT_TRUE(std::isinf(castRay(w, near, o, {1, 0, 0}, 2.0)));  // beyond max range
+}
+
+TEST(World, RayFindsUnevenGround) {
+  World w;
+  w.ground = {true, 0.3, 5, 0.2, 4, 0.01};
+  const Eigen::Vector3d o(0, 0, 2), d = Eigen::Vector3d(1, 0.5, -0.5).normalized();
+  const double t = castRay(w, solidsNear(w, o, 50), o, d, 50);
+  ASSERT_TRUE(std::isfinite(t));
+  const Eigen::Vector3d p = o + t * d;
+  EXPECT_NEAR(p.z(), w.ground.height(p.x(), p.y()), 2e-3);
+}
+
+static std::set<std::tuple<int, int, int>> cells(const Points& pts, double leaf) {
+  std::set<std::tuple<int, int, int>> s;
+  for (const auto& p : pts)
+    s.insert({static_cast<int>(std::floor(p.x() / leaf)), static_cast<int>(std::floor(p.y() / leaf)),
+              static_cast<int>(std::floor(p.z() / leaf))});
+  return s;
+}
+
+class SynthWorld : public ::testing::TestWithParam<WorldType> {};
+
+TEST_P(SynthWorld, SameSeedSameMapsAndGroundTruthAlignsThem) {
+  SceneParams sp;
+  sp.type = GetParam();
+  sp.seed = 4;
+  const Scene scene = makeScene(sp);
+  const auto a = scanScene(scene, noiseLevel("low"), 4);
+  const auto b = scanScene(makeScene(sp), noiseLevel("low"), 4);
+  ASSERT_EQ(a.size(), 2u);
+  ASSERT_EQ(a[1].points.size(), b[1].points.size());
+  EXPECT_EQ(a[1].points[1000], b[1].points[1000]);
+  EXPECT_TRUE(a[0].pose.isApprox(b[0].pose));
+  EXPECT_GT(a[0].points.size(), 50000u);
+
+  // Moved by the ground truth, a good share of the source falls on target cells;
+  // moved by the inverse (the classic convention slip), far less does.
+  const Pose4 T = Pose4::fromMatrix(a[0].pose * a[1].pose.inverse());
+  const double leaf = 2 * scene.grid;
+  const auto target = cells(a[0].points, leaf);
+  auto overlap = [&](const Pose4& M) {
+    size_t hit = 0;
+    for (const auto& c : cells(transformPoints(a[1].points, M), leaf)) hit += target.count(c);
+    return static_cast<double>(hit) / static_cast<double>(target.size());
+  };
+  EXPECT_GT(overlap(T), 0.2);
+  EXPECT_GT(overlap(T), 2 * overlap(T.inverse()));
+}
+
+TEST_P(SynthWorld, OtherSeedOtherWorld) {
+  SceneParams a, b;
+  a.type = b.type = GetParam();
+  a.seed = 1;
+  b.seed = 2;
+  const Scene sa = makeScene(a), sb = makeScene(b);
+  EXPECT_FALSE(sa.world.boxes.back().lo.isApprox(sb.world.boxes.back().lo) &&
+               sa.world.boxes.size() == sb.world.boxes.size());
+  EXPECT_TRUE(makeScene(a).world.boxes.back().lo.isApprox(sa.world.boxes.back().lo));
+}
+
+INSTANTIATE_TEST_SUITE_P(Types, SynthWorld, ::testing::Values(WorldType::Indoor, WorldType::Outdoor),
+                         [](const auto& p) { return toString(p.param); });
+
+TEST(Synth, BadNamesAreInputErrors) {
+  EXPECT_THROW(parseWorldType("forest"), InputError);
+  EXPECT_THROW(noiseLevel("extreme"), InputError);
+  SceneParams sp;
+  sp.maps = 0;
+  EXPECT_THROW(makeScene(sp), InputError);
+}
