@@ -10,7 +10,7 @@ PACKAGES=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libsystemd-dev
-  python3
+  python3 time
 )
 
 missing=()

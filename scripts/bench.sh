@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Speed and memory of `tomomap match`: median wall time over RUNS runs and peak
+# RSS of the whole process (load, filter, slice, features, match), per case.
+# Usage: scripts/bench.sh [RUNS]   (default 7; the build must exist: scripts/build.sh)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+runs=${1:-7}
+tomomap=${BUILD_DIR:-build}/src/cli/tomomap
+demo=${DEMO_ROOM:-../shared/data/demo-room}
+work=$(mktemp -d /tmp/tomomap-bench.XXXXXX)
+trap 'rm -rf "$work"' EXIT
+command -v /usr/bin/time >/dev/null || { echo "bench: needs GNU time (apt-get install time)" >&2; exit 2; }
+
+median() { sort -n | awk '{a[NR]=$1} END {print (NR%2) ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2}'; }
+
+# bench NAME TARGET SOURCE GRID [extra args]
+bench() {
+  local name=$1 target=$2 source=$3 grid=$4; shift 4
+  local times=() rss=()
+  for ((i = 0; i < runs; i++)); do
+    /usr/bin/time -f "%e %M" -o "$work/t" "$tomomap" match "$target" "$source" --grid "$grid" -q "$@" >"$work/out" || true
+    read -r t m <"$work/t"
+    times+=("$t"); rss+=("$m")
+  done
+  local err
+  err=$(grep -o 'translation [0-9.]* m' "$work/out" | head -1 || true)
+  printf '%-34s median %6.3f s  (min %6.3f, max %6.3f)  peak RSS %4d MB  %s\n' "$name" \
+    "$(printf '%s\n' "${times[@]}" | median)" "$(printf '%s\n' "${times[@]}" | sort -n | head -1)" \
+    "$(printf '%s\n' "${times[@]}" | sort -n | tail -1)" "$(( $(printf '%s\n' "${rss[@]}" | sort -n | tail -1) / 1024 ))" \
+    "${err:+error $err}"
+}
+
+echo "tomomap $("$tomomap" --version | awk '{print $2}'), $runs runs per case, $(nproc) cores, $(date -u +%Y-%m-%d)"
+if [ -f "$demo/demo-pcd1.pcd" ]; then
+  bench "demo-room pcd2 -> pcd1 (g 0.05)" "$demo/demo-pcd1.pcd" "$demo/demo-pcd2.pcd" 0.05 \
+    --gt-target "$demo/demo-pcd1-gtpose.txt" --gt-source "$demo/demo-pcd2-gtpose.txt"
+  bench "demo-room pcd1 -> pcd2 (g 0.05)" "$demo/demo-pcd2.pcd" "$demo/demo-pcd1.pcd" 0.05 \
+    --gt-target "$demo/demo-pcd2-gtpose.txt" --gt-source "$demo/demo-pcd1-gtpose.txt"
+  bench "demo-room, 1 thread" "$demo/demo-pcd1.pcd" "$demo/demo-pcd2.pcd" 0.05 -j 1
+else
+  echo "demo-room not found at $demo: skipped"
+fi
+"$tomomap" synth --world indoor --seed 1 --scale 2.5 --out "$work/building" >/dev/null
+b=$work/building
+pts=$(grep -o '"points": [0-9]*' "$b/scene.json" | head -1 | awk '{print $2}')
+echo "synthetic 2-floor building 60 x 14 x 6.2 m, $pts points per map:"
+for g in 0.2 0.1 0.05; do
+  bench "  building (g $g)" "$b/map_0.pcd" "$b/map_1.pcd" "$g" --gt-target "$b/map_0-gtpose.txt" --gt-source "$b/map_1-gtpose.txt"
+done
+"$tomomap" synth --world outdoor --seed 1 --scale 2 --out "$work/street" >/dev/null
+s=$work/street
+pts=$(grep -o '"points": [0-9]*' "$s/scene.json" | head -1 | awk '{print $2}')
+echo "synthetic street 240 m, $pts points per map:"
+for g in 0.5 0.2; do
+  bench "  street (g $g)" "$s/map_0.pcd" "$s/map_1.pcd" "$g" --gt-target "$s/map_0-gtpose.txt" --gt-source "$s/map_1-gtpose.txt"
+done
