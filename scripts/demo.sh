@@ -9,7 +9,7 @@ tomomap=${BUILD_DIR:-build}/src/cli/tomomap
 out=${DEMO_DIR:-$(mktemp -d /tmp/tomomap-demo.XXXXXX)}
 for world in indoor outdoor; do
   echo "== $world world: generating two overlapping maps (seed 7, low noise)"
-  $tomomap synth --world "$world" --seed 7 --noise low --out "$out/$world" --progress | tail -n +1 | grep -v '^match with'
+  $tomomap synth --world "$world" --seed 7 --noise low --out "$out/$world" --progress | grep -v '^match with'
   grid=$(grep -o '"grid": [0-9.]*' "$out/$world/scene.json" | awk '{print $2}')
   echo "== $world world: matching map_1 (source) into map_0 (target) at grid $grid m"
   $tomomap match "$out/$world/map_0.pcd" "$out/$world/map_1.pcd" --grid "$grid" \

@@ -12,6 +12,8 @@ struct WorldCase {
   const char* noise;
 };
 
+void PrintTo(const WorldCase& c, std::ostream* os) { *os << toString(c.type) << "/" << c.noise; }
+
 class SynthAccuracy : public ::testing::TestWithParam<WorldCase> {};
 
 TEST_P(SynthAccuracy, AtLeastNineOfTenSeedsSucceed) {

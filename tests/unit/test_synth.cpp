@@ -39,6 +39,10 @@ static std::set<std::tuple<int, int, int>> cells(const Points& pts, double leaf)
   return s;
 }
 
+namespace tomomap::synth {
+void PrintTo(WorldType t, std::ostream* os) { *os << toString(t); }
+}  // namespace tomomap::synth
+
 class SynthWorld : public ::testing::TestWithParam<WorldType> {};
 
 TEST_P(SynthWorld, SameSeedSameMapsAndGroundTruthAlignsThem) {
