@@ -31,26 +31,33 @@ GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const Eigen::Matr
   return c;
 }
 
-void printResult(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& gt) {
+void printResult(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& gt, bool baseline) {
   const auto& T = r.T_target_source;
   if (r.reliable) {
     out << format("T_target_source  x %.4f  y %.4f  z %.4f m  yaw %.4f rad (%.2f deg)\n", T.x, T.y, T.z, T.yaw,
                   T.yaw * 180.0 / kPi);
     const Eigen::Matrix4d M = T.matrix();
-    for (int i = 0; i < 4; ++i)
-      out << format("  [%9.5f %9.5f %9.5f %9.4f]\n", M(i, 0), M(i, 1), M(i, 2), M(i, 3));
+    for (int i = 0; i < 4; ++i) out << format("  [%9.5f %9.5f %9.5f %9.4f]\n", M(i, 0), M(i, 1), M(i, 2), M(i, 3));
   } else {
     out << "no reliable match: " << r.reason << "\n";
   }
-  out << format("quality          support %d slice pairs (runner-up %d), %zu inliers, spread x %.2f y %.2f z %.2f m\n",
-                r.support, r.runner_up_support, r.inliers, r.inlier_spread.x(), r.inlier_spread.y(),
-                r.inlier_spread.z());
-  out << format("slices           target %d (%zu features), source %d (%zu features), %zu slice pairs\n",
-                r.target_slices, r.target_features, r.source_slices, r.source_features, r.slice_pairs);
-  const auto& t = r.timings;
-  out << format("time             %.3f s: voxel %.3f, slicing %.3f, features %.3f, pair matching %.3f, "
-                "consensus %.3f, refinement %.3f\n",
-                t.total(), t.voxel, t.slicing, t.features, t.pair_matching, t.consensus, t.refinement);
+  if (baseline) {
+    out << format("keypoints        target %zu, source %zu, %zu inliers\n", r.target_features, r.source_features,
+                  r.inliers);
+    out << format("time             %.3f s: normals + FPFH %.3f, RANSAC %.3f\n", r.timings.total(), r.timings.features,
+                  r.timings.pair_matching);
+  } else {
+    out << format(
+        "quality          support %d slice pairs (runner-up %d), %zu inliers, spread x %.2f y %.2f z %.2f m\n",
+        r.support, r.runner_up_support, r.inliers, r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z());
+    out << format("slices           target %d (%zu features), source %d (%zu features), %zu slice pairs\n",
+                  r.target_slices, r.target_features, r.source_slices, r.source_features, r.slice_pairs);
+    const auto& t = r.timings;
+    out << format(
+        "time             %.3f s: voxel %.3f, slicing %.3f, features %.3f, pair matching %.3f, "
+        "consensus %.3f, refinement %.3f\n",
+        t.total(), t.voxel, t.slicing, t.features, t.pair_matching, t.consensus, t.refinement);
+  }
   if (gt) {
     const auto& e = gt->expected;
     out << format("ground truth     x %.4f  y %.4f  z %.4f m  yaw %.4f rad\n", e.x, e.y, e.z, e.yaw);
@@ -64,18 +71,24 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
 nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck>& gt) {
   nlohmann::json j;
   j["reliable"] = r.reliable;
-  if (r.reliable) j["T_target_source"] = poseJson(r.T_target_source);
-  else j["reason"] = r.reason;
+  if (r.reliable)
+    j["T_target_source"] = poseJson(r.T_target_source);
+  else
+    j["reason"] = r.reason;
   j["quality"] = {{"support", r.support},
                   {"runner_up_support", r.runner_up_support},
                   {"inliers", r.inliers},
                   {"inlier_spread", {r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z()}}};
-  j["slices"] = {{"target", r.target_slices}, {"source", r.source_slices}, {"pairs", r.slice_pairs},
-                 {"target_features", r.target_features}, {"source_features", r.source_features}};
+  j["slices"] = {{"target", r.target_slices},
+                 {"source", r.source_slices},
+                 {"pairs", r.slice_pairs},
+                 {"target_features", r.target_features},
+                 {"source_features", r.source_features}};
   const auto& t = r.timings;
-  j["timings_s"] = {{"voxel", t.voxel},   {"slicing", t.slicing},     {"features", t.features},
-                    {"pair_matching", t.pair_matching}, {"consensus", t.consensus},
-                    {"refinement", t.refinement}, {"total", t.total()}};
+  j["timings_s"] = {{"voxel", t.voxel},         {"slicing", t.slicing},
+                    {"features", t.features},   {"pair_matching", t.pair_matching},
+                    {"consensus", t.consensus}, {"refinement", t.refinement},
+                    {"total", t.total()}};
   if (gt) {
     j["ground_truth"] = poseJson(gt->expected);
     if (r.reliable)

@@ -20,7 +20,9 @@ struct GroundTruthCheck {
 GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const Eigen::Matrix4d& P_target,
                                          const Eigen::Matrix4d& P_source, double grid);
 
-void printResult(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& gt);
+/// `baseline` prints the FPFH-RANSAC result's keypoints instead of slices.
+void printResult(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& gt,
+                 bool baseline = false);
 
 nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck>& gt);
 

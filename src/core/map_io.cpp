@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -27,10 +28,38 @@ std::string lowerExtension(const std::string& path) {
 // PCL reports parse problems on stderr; we report them ourselves, once.
 void silencePcl() { pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); }
 
-Points fromPcl(const pcl::PointCloud<pcl::PointXYZ>& cloud) {
-  Points out;
-  out.reserve(cloud.size());
-  for (const auto& p : cloud) out.emplace_back(p.x, p.y, p.z);
+/// Reads x, y, z straight out of PCL's blob: no intermediate PointCloud, which
+/// for a map of millions of points would hold a third copy in memory.
+Points fromBlob(const pcl::PCLPointCloud2& blob, const std::string& path) {
+  int offset[3];
+  uint8_t type[3];
+  const char* axes[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    const int f = pcl::getFieldIndex(blob, axes[a]);
+    if (f < 0) throw InputError(path + ": has no '" + axes[a] + "' field");
+    offset[a] = static_cast<int>(blob.fields[static_cast<size_t>(f)].offset);
+    type[a] = blob.fields[static_cast<size_t>(f)].datatype;
+    if (type[a] != pcl::PCLPointField::FLOAT32 && type[a] != pcl::PCLPointField::FLOAT64)
+      throw InputError(path + ": field '" + axes[a] + "' is not a float");
+  }
+  const size_t n = static_cast<size_t>(blob.width) * blob.height;
+  if (blob.point_step == 0 || blob.data.size() < n * blob.point_step)
+    throw InputError(path + ": truncated (header declares " + std::to_string(n) + " points)");
+  Points out(n);
+  for (size_t i = 0; i < n; ++i) {
+    const uint8_t* p = blob.data.data() + i * blob.point_step;
+    for (int a = 0; a < 3; ++a) {
+      if (type[a] == pcl::PCLPointField::FLOAT32) {
+        float v;
+        std::memcpy(&v, p + offset[a], sizeof v);
+        out[i][a] = v;
+      } else {
+        double v;
+        std::memcpy(&v, p + offset[a], sizeof v);
+        out[i][a] = static_cast<float>(v);
+      }
+    }
+  }
   return out;
 }
 
@@ -40,16 +69,7 @@ Points loadPcl(const std::string& path, bool ply) {
   pcl::PCLPointCloud2 blob;
   const int rc = ply ? pcl::io::loadPLYFile(path, blob) : pcl::io::loadPCDFile(path, blob);
   if (rc < 0) throw InputError(path + ": not a readable " + (ply ? "PLY" : "PCD") + " file (corrupt or truncated)");
-  for (const char* axis : {"x", "y", "z"}) {
-    if (pcl::getFieldIndex(blob, axis) < 0)
-      throw InputError(path + ": has no '" + axis + "' field");
-  }
-  const size_t declared = static_cast<size_t>(blob.width) * blob.height;
-  if (blob.point_step == 0 || blob.data.size() < declared * blob.point_step)
-    throw InputError(path + ": truncated (header declares " + std::to_string(declared) + " points)");
-  pcl::PointCloud<pcl::PointXYZ> cloud;
-  pcl::fromPCLPointCloud2(blob, cloud);
-  return fromPcl(cloud);
+  return fromBlob(blob, path);
 }
 
 Points loadXyz(const std::string& path) {

@@ -154,3 +154,16 @@ TEST(Cli, SynthRejectsBadOptions) {
   expectBadInput(runTomomap("synth --maps 0 --out " + (dir / "x")), "--maps");
   EXPECT_EQ(runTomomap("synth").exit_code, 2);  // --out is required
 }
+
+TEST(Cli, FpfhRansacBaselineRunsOnTheSamePair) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  const auto r = runTomomap(demoMatchArgs() + " --method fpfh-ransac -j 2 --json " + (dir / "b.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("normals + FPFH"), std::string::npos);
+  std::ifstream in(dir / "b.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["method"], "fpfh-ransac");
+  EXPECT_TRUE(j["error"]["success"].get<bool>()) << j.dump();
+  EXPECT_EQ(runTomomap("match a b --method icp").exit_code, 2);
+}
