@@ -38,10 +38,10 @@ struct CommandResult {
   std::string output;  ///< stdout and stderr together
 };
 
-/// Runs the tomomap binary with `args` (shell syntax) and captures its output.
-inline CommandResult runTomomap(const std::string& args) {
+/// Runs `binary` with `args` (shell syntax) and captures its output.
+inline CommandResult runBinary(const std::string& binary, const std::string& args) {
   CommandResult r;
-  const std::string cmd = std::string(TOMOMAP_BIN) + " " + args + " 2>&1";
+  const std::string cmd = binary + " " + args + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) return r;
   std::array<char, 4096> buf;
@@ -51,6 +51,8 @@ inline CommandResult runTomomap(const std::string& args) {
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+inline CommandResult runTomomap(const std::string& args) { return runBinary(TOMOMAP_BIN, args); }
 
 /// Demo-room maps and the expected T_1_2 (target pcd1, source pcd2).
 struct DemoPair {

@@ -43,15 +43,19 @@ int runSynth(const SynthOptions& o) {
     if (show && (done % 16 == 0 || done == total)) terminalProgress(true)("scans", done, total);
   });
 
-  nlohmann::json index = {{"world", o.world}, {"seed", o.seed}, {"grid", scene.grid},
-                          {"noise", {{"pose_translation", noise.pose_translation}, {"pose_yaw", noise.pose_yaw},
-                                     {"range", noise.range}}},
-                          {"maps", nlohmann::json::array()}};
+  nlohmann::json index = {
+      {"world", o.world},
+      {"seed", o.seed},
+      {"grid", scene.grid},
+      {"noise", {{"pose_translation", noise.pose_translation}, {"pose_yaw", noise.pose_yaw}, {"range", noise.range}}},
+      {"maps", nlohmann::json::array()}};
   for (size_t i = 0; i < maps.size(); ++i) {
     const std::string stem = (std::filesystem::path(o.out) / ("map_" + std::to_string(i))).string();
     savePcd(stem + ".pcd", maps[i].points);
     savePoseFile(stem + "-gtpose.txt", maps[i].pose);
-    index["maps"].push_back({{"map", stem + ".pcd"}, {"pose", stem + "-gtpose.txt"}, {"points", maps[i].points.size()},
+    index["maps"].push_back({{"map", stem + ".pcd"},
+                             {"pose", stem + "-gtpose.txt"},
+                             {"points", maps[i].points.size()},
                              {"scans", scene.trajectories[i].size()}});
     std::cout << stem << ".pcd  " << maps[i].points.size() << " points from " << scene.trajectories[i].size()
               << " scans (" << maps[i].hits << " of " << maps[i].rays << " rays hit)\n";
@@ -66,7 +70,8 @@ int runSynth(const SynthOptions& o) {
 
 Command addSynthCommand(CLI::App& app) {
   auto o = std::make_shared<SynthOptions>();
-  CLI::App* sub = app.add_subcommand("synth", "Generate overlapping maps of a procedural world with ground-truth poses.");
+  CLI::App* sub =
+      app.add_subcommand("synth", "Generate overlapping maps of a procedural world with ground-truth poses.");
   sub->add_option("-o,--out", o->out, "output directory (map_N.pcd, map_N-gtpose.txt, scene.json)")->required();
   sub->add_option("-w,--world", o->world, "world type: indoor (2-floor building) or outdoor (street)")
       ->capture_default_str()
@@ -78,10 +83,14 @@ Command addSynthCommand(CLI::App& app) {
   sub->add_option("--noise", o->noise, "noise level: none, low (0.02 m / 0.01 rad) or high (0.05 m / 0.025 rad)")
       ->capture_default_str()
       ->check(CLI::IsMember({"none", "low", "high"}));
-  sub->add_option("--pose-sigma", o->pose_sigma, "override: per-scan position noise [m]")->check(CLI::NonNegativeNumber);
+  sub->add_option("--pose-sigma", o->pose_sigma, "override: per-scan position noise [m]")
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--yaw-sigma", o->yaw_sigma, "override: per-scan yaw noise [rad]")->check(CLI::NonNegativeNumber);
-  sub->add_option("--range-sigma", o->range_sigma, "override: range noise at up to 3 m [m]")->check(CLI::NonNegativeNumber);
-  sub->add_option("--scale", o->scale, "stretch the world's length (0.5 to 20)")->capture_default_str()->check(CLI::Range(0.5, 20.0));
+  sub->add_option("--range-sigma", o->range_sigma, "override: range noise at up to 3 m [m]")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--scale", o->scale, "stretch the world's length (0.5 to 20)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.5, 20.0));
   sub->add_flag("--progress", o->progress, "show progress even when stderr is not a terminal");
   return {sub, [o] { return runSynth(*o); }};
 }

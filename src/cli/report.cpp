@@ -1,6 +1,10 @@
 #include "report.hpp"
 
 #include <cstdio>
+#include <fstream>
+#include <iostream>
+
+#include "exit_codes.hpp"
 
 namespace tomomap::cli {
 namespace {
@@ -95,6 +99,25 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
       j["error"] = {{"translation", gt->error.translation}, {"yaw", gt->error.yaw}, {"success", gt->success()}};
   }
   return j;
+}
+
+int report(const MatchResult& r, const std::optional<Eigen::Matrix4d>& P_target,
+           const std::optional<Eigen::Matrix4d>& P_source, double grid, const std::string& json, bool baseline) {
+  std::optional<GroundTruthCheck> gt;
+  if (P_target && P_source) gt = checkAgainstGroundTruth(r, *P_target, *P_source, grid);
+  printResult(std::cout, r, gt, baseline);
+  if (!json.empty()) {
+    std::ofstream out(json);
+    auto j = toJson(r, gt);
+    j["method"] = baseline ? "fpfh-ransac" : "tomomap";
+    out << j.dump(2) << "\n";
+    if (!out) throw InputError(json + ": cannot write JSON result");
+  }
+  return r.reliable ? kExitOk : kExitNoMatch;
+}
+
+void requireBothOrNeither(const std::string& gt_target, const std::string& gt_source) {
+  if (gt_target.empty() != gt_source.empty()) throw InputError("--gt-target and --gt-source go together");
 }
 
 }  // namespace tomomap::cli

@@ -89,7 +89,7 @@ TEST(Cli, EmptyTinyNanTruncatedAndCorruptMaps) {
   expectBadInput(runTomomap("match " + good + " " + (dir / "cut.pcd")), "cut.pcd");
   expectBadInput(runTomomap("match " + good + " " + (dir / "corrupt.pcd")), "corrupt.pcd");
   // One line of diagnosis, not a dump.
-  EXPECT_EQ(lines(runTomomap("match " + good + " " + (dir / "cut.pcd")).output), 1u);
+  EXPECT_EQ(lines(runTomomap("match -q " + good + " " + (dir / "cut.pcd")).output), 1u);
 }
 
 TEST(Cli, BadGridValues) {
@@ -158,12 +158,13 @@ TEST(Cli, SynthRejectsBadOptions) {
 TEST(Cli, FpfhRansacBaselineRunsOnTheSamePair) {
   REQUIRE_DEMO_ROOM();
   TempDir dir;
-  const auto r = runTomomap(demoMatchArgs() + " --method fpfh-ransac -j 2 --json " + (dir / "b.json"));
+  const auto r = test::runBinary(TOMOMAP_BASELINE_BIN, demoMatchArgs().substr(6) + " -j 2 --json " + (dir / "b.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("normals + FPFH"), std::string::npos);
   std::ifstream in(dir / "b.json");
   const auto j = nlohmann::json::parse(in);
   EXPECT_EQ(j["method"], "fpfh-ransac");
   EXPECT_TRUE(j["error"]["success"].get<bool>()) << j.dump();
-  EXPECT_EQ(runTomomap("match a b --method icp").exit_code, 2);
+  EXPECT_EQ(test::runBinary(TOMOMAP_BASELINE_BIN, "a.pcd b.pcd --grid 0").exit_code, 2);
+  EXPECT_EQ(test::runBinary(TOMOMAP_BASELINE_BIN, "/nonexistent.pcd b.pcd").exit_code, 2);
 }

@@ -1,0 +1,131 @@
+#include "suite.hpp"
+
+#include <toml++/toml.h>
+
+#include <filesystem>
+#include <set>
+
+#include "core/types.hpp"
+
+namespace tomomap::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void fail(const std::string& file, const toml::source_region& at, const std::string& what) {
+  throw InputError(file + ":" + std::to_string(at.begin.line) + ":" + std::to_string(at.begin.column) + ": " + what);
+}
+
+void checkKeys(const std::string& file, const toml::table& t, const std::set<std::string>& allowed,
+               const std::string& where) {
+  for (const auto& [key, node] : t)
+    if (!allowed.count(std::string(key.str())))
+      fail(file, node.source(), "unknown key '" + std::string(key.str()) + "' in " + where);
+}
+
+std::string text(const std::string& file, const toml::table& t, const std::string& key, const std::string& where,
+                 const std::optional<std::string>& fallback = std::nullopt) {
+  const toml::node* n = t.get(key);
+  if (!n) {
+    if (fallback) return *fallback;
+    fail(file, t.source(), where + " needs '" + key + "'");
+  }
+  if (!n->is_string()) fail(file, n->source(), "'" + key + "' must be a string");
+  return n->value<std::string>().value();
+}
+
+double number(const std::string& file, const toml::table& t, const std::string& key, double fallback) {
+  const toml::node* n = t.get(key);
+  if (!n) return fallback;
+  const auto v = n->value<double>();
+  if (!v || !(*v > 0)) fail(file, n->source(), "'" + key + "' must be a positive number");
+  return *v;
+}
+
+template <typename T>
+std::vector<T> list(const std::string& file, const toml::table& t, const std::string& key, std::vector<T> fallback) {
+  const toml::node* n = t.get(key);
+  if (!n) return fallback;
+  const toml::array* a = n->as_array();
+  if (!a || a->empty()) fail(file, n->source(), "'" + key + "' must be a non-empty list");
+  std::vector<T> out;
+  for (const auto& e : *a) {
+    const auto v = e.value<T>();
+    if (!v) fail(file, e.source(), "'" + key + "' has an element of the wrong type");
+    out.push_back(*v);
+  }
+  return out;
+}
+
+}  // namespace
+
+Suite loadSuite(const std::string& path) {
+  if (!fs::exists(path)) throw InputError(path + ": no such suite file");
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    fail(path, e.source(), std::string(e.description()));
+  }
+  checkKeys(path, root, {"name", "methods", "pair", "synth"}, "the suite");
+  const fs::path base = fs::path(path).parent_path();
+  auto resolve = [&](const std::string& p) {
+    return fs::path(p).is_absolute() ? p : (base / p).lexically_normal().string();
+  };
+
+  Suite s;
+  s.name = text(path, root, "name", "the suite", fs::path(path).stem().string());
+  s.methods = list<std::string>(path, root, "methods", s.methods);
+  for (const auto& m : s.methods)
+    if (m != "tomomap" && m != "fpfh-ransac")
+      fail(path, root.get("methods")->source(), "unknown method '" + m + "' (use tomomap or fpfh-ransac)");
+
+  if (const toml::node* pairs = root.get("pair")) {
+    const toml::array* a = pairs->as_array();
+    if (!a) fail(path, pairs->source(), "'pair' must be an array of tables ([[pair]])");
+    for (const auto& e : *a) {
+      const toml::table* t = e.as_table();
+      if (!t) fail(path, e.source(), "each [[pair]] must be a table");
+      checkKeys(path, *t, {"name", "target", "source", "gt_target", "gt_source", "grid"}, "[[pair]]");
+      SuitePair p;
+      p.target = resolve(text(path, *t, "target", "[[pair]]"));
+      p.source = resolve(text(path, *t, "source", "[[pair]]"));
+      p.gt_target = resolve(text(path, *t, "gt_target", "[[pair]]"));
+      p.gt_source = resolve(text(path, *t, "gt_source", "[[pair]]"));
+      p.name = text(path, *t, "name", "[[pair]]",
+                    fs::path(p.source).stem().string() + " -> " + fs::path(p.target).stem().string());
+      p.grid = number(path, *t, "grid", 0.05);
+      std::string missing;
+      for (const auto* f : {&p.target, &p.source, &p.gt_target, &p.gt_source})
+        if (!fs::exists(*f)) missing = *f;
+      if (!missing.empty())
+        s.warnings.push_back("pair '" + p.name + "' left out: " + missing + ": no such file");
+      else
+        s.pairs.push_back(p);
+    }
+  }
+  if (const toml::node* synth = root.get("synth")) {
+    const toml::array* a = synth->as_array();
+    if (!a) fail(path, synth->source(), "'synth' must be an array of tables ([[synth]])");
+    for (const auto& e : *a) {
+      const toml::table* t = e.as_table();
+      if (!t) fail(path, e.source(), "each [[synth]] must be a table");
+      checkKeys(path, *t, {"world", "seeds", "noise", "scale"}, "[[synth]]");
+      SuiteSynth y;
+      y.world = text(path, *t, "world", "[[synth]]");
+      if (y.world != "indoor" && y.world != "outdoor")
+        fail(path, t->get("world")->source(), "unknown world '" + y.world + "'");
+      y.seeds = list<int64_t>(path, *t, "seeds", y.seeds);
+      y.noise = list<std::string>(path, *t, "noise", y.noise);
+      for (const auto& n : y.noise)
+        if (n != "none" && n != "low" && n != "high")
+          fail(path, t->get("noise")->source(), "unknown noise level '" + n + "'");
+      y.scale = number(path, *t, "scale", 1.0);
+      s.synth.push_back(y);
+    }
+  }
+  if (s.pairs.empty() && s.synth.empty() && s.warnings.empty()) throw InputError(path + ": the suite lists no pairs");
+  return s;
+}
+
+}  // namespace tomomap::cli
