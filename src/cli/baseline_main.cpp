@@ -35,7 +35,8 @@ int main(int argc, char** argv) {
     std::optional<Eigen::Matrix4d> P_target, P_source;
     if (!gt_target.empty()) P_target = loadPoseFile(gt_target);
     if (!gt_source.empty()) P_source = loadPoseFile(gt_source);
-    const baseline::FpfhResult b = baseline::matchFpfhRansac(loadMap(target), loadMap(source), p);
+    const Points t = loadMap(target), s = loadMap(source);
+    const baseline::FpfhResult b = baseline::matchFpfhRansac(t, s, p);
     MatchResult r;
     r.reliable = b.converged;
     if (!b.converged) r.reason = "FPFH-RANSAC did not converge";
@@ -45,6 +46,7 @@ int main(int argc, char** argv) {
     r.source_features = b.source_keypoints;
     r.timings.features = b.describe_seconds;
     r.timings.pair_matching = b.ransac_seconds;
-    return report(r, P_target, P_source, p.grid, json, /*baseline=*/true);
+    return report(r, P_target, P_source, p.grid, json, /*baseline=*/true,
+                  {{"target_points", t.size()}, {"source_points", s.size()}});
   });
 }

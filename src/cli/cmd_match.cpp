@@ -26,8 +26,10 @@ int runMatch(const MatchOptions& o) {
   // One map at a time: its raw points are dropped once described, which halves
   // peak memory on maps of millions of points.
   StageTimings timings;
+  nlohmann::json sizes;
   auto describe = [&](const std::string& path, const char* role) {
     const Points map = loadMap(path);
+    sizes[std::string(role) + "_points"] = map.size();
     if (!o.quiet) std::cout << role << " " << path << " (" << map.size() << " points)\n";
     return describeMap(map, o.params, &timings);
   };
@@ -38,7 +40,7 @@ int runMatch(const MatchOptions& o) {
   r.timings.voxel = timings.voxel;
   r.timings.slicing = timings.slicing;
   r.timings.features = timings.features;
-  return report(r, P_target, P_source, o.params.grid, o.json, false);
+  return report(r, P_target, P_source, o.params.grid, o.json, false, sizes);
 }
 
 }  // namespace

@@ -1,14 +1,10 @@
 // `tomomap synth`: generate overlapping maps of a procedural world with ground truth.
-#include <filesystem>
-#include <fstream>
 #include <iostream>
-#include <nlohmann/json.hpp>
 
 #include "commands.hpp"
-#include "core/map_io.hpp"
 #include "exit_codes.hpp"
 #include "progress.hpp"
-#include "synth/synth.hpp"
+#include "synth_files.hpp"
 
 namespace tomomap::cli {
 namespace {
@@ -33,36 +29,13 @@ int runSynth(const SynthOptions& o) {
   if (o.yaw_sigma) noise.pose_yaw = *o.yaw_sigma;
   if (o.range_sigma) noise.range = *o.range_sigma;
 
-  std::error_code ec;
-  std::filesystem::create_directories(o.out, ec);
-  if (ec) throw InputError(o.out + ": cannot create output directory: " + ec.message());
-
-  const synth::Scene scene = synth::makeScene(sp);
   const bool show = o.progress || stderrIsTerminal();
-  const auto maps = synth::scanScene(scene, noise, o.seed, [show](size_t done, size_t total) {
+  const GeneratedWorld w = writeSynthWorld(sp, noise, o.out, [show](size_t done, size_t total) {
     if (show && (done % 16 == 0 || done == total)) terminalProgress(true)("scans", done, total);
   });
-
-  nlohmann::json index = {
-      {"world", o.world},
-      {"seed", o.seed},
-      {"grid", scene.grid},
-      {"noise", {{"pose_translation", noise.pose_translation}, {"pose_yaw", noise.pose_yaw}, {"range", noise.range}}},
-      {"maps", nlohmann::json::array()}};
-  for (size_t i = 0; i < maps.size(); ++i) {
-    const std::string stem = (std::filesystem::path(o.out) / ("map_" + std::to_string(i))).string();
-    savePcd(stem + ".pcd", maps[i].points);
-    savePoseFile(stem + "-gtpose.txt", maps[i].pose);
-    index["maps"].push_back({{"map", stem + ".pcd"},
-                             {"pose", stem + "-gtpose.txt"},
-                             {"points", maps[i].points.size()},
-                             {"scans", scene.trajectories[i].size()}});
-    std::cout << stem << ".pcd  " << maps[i].points.size() << " points from " << scene.trajectories[i].size()
-              << " scans (" << maps[i].hits << " of " << maps[i].rays << " rays hit)\n";
-  }
-  std::ofstream(std::filesystem::path(o.out) / "scene.json") << index.dump(2) << "\n";
-  std::cout << "match with: tomomap match " << o.out << "/map_0.pcd " << o.out << "/map_1.pcd --grid " << scene.grid
-            << " --gt-target " << o.out << "/map_0-gtpose.txt --gt-source " << o.out << "/map_1-gtpose.txt\n";
+  for (size_t i = 0; i < w.maps.size(); ++i) std::cout << w.maps[i] << "  " << w.points[i] << " points\n";
+  std::cout << "match with: tomomap match " << w.maps[0] << " " << w.maps.back() << " --grid " << w.grid
+            << " --gt-target " << w.poses[0] << " --gt-source " << w.poses.back() << "\n";
   return kExitOk;
 }
 

@@ -102,7 +102,8 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
 }
 
 int report(const MatchResult& r, const std::optional<Eigen::Matrix4d>& P_target,
-           const std::optional<Eigen::Matrix4d>& P_source, double grid, const std::string& json, bool baseline) {
+           const std::optional<Eigen::Matrix4d>& P_source, double grid, const std::string& json, bool baseline,
+           const nlohmann::json& extra) {
   std::optional<GroundTruthCheck> gt;
   if (P_target && P_source) gt = checkAgainstGroundTruth(r, *P_target, *P_source, grid);
   printResult(std::cout, r, gt, baseline);
@@ -110,6 +111,7 @@ int report(const MatchResult& r, const std::optional<Eigen::Matrix4d>& P_target,
     std::ofstream out(json);
     auto j = toJson(r, gt);
     j["method"] = baseline ? "fpfh-ransac" : "tomomap";
+    if (extra.is_object()) j.update(extra);
     out << j.dump(2) << "\n";
     if (!out) throw InputError(json + ": cannot write JSON result");
   }

@@ -29,7 +29,8 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
 /// Prints the result (and its error against ground truth when both poses are
 /// given), writes the JSON file when `json` is not empty, and returns the exit code.
 int report(const MatchResult& r, const std::optional<Eigen::Matrix4d>& P_target,
-           const std::optional<Eigen::Matrix4d>& P_source, double grid, const std::string& json, bool baseline);
+           const std::optional<Eigen::Matrix4d>& P_source, double grid, const std::string& json, bool baseline,
+           const nlohmann::json& extra = {});
 
 /// Throws InputError unless both ground-truth options or neither are given.
 void requireBothOrNeither(const std::string& gt_target, const std::string& gt_source);

@@ -1,0 +1,21 @@
+#pragma once
+// Runs a program as a child process and measures it: wall time and peak RSS of
+// that process alone (wait4's rusage), so one method's memory never hides another's.
+#include <string>
+#include <vector>
+
+namespace tomomap::cli {
+
+struct ChildRun {
+  int exit_code = -1;      ///< -1 if it did not exit normally (signal)
+  double seconds = 0;      ///< wall time
+  double peak_rss_mb = 0;  ///< maximum resident set size
+  std::string output;      ///< stdout and stderr together
+};
+
+ChildRun runChild(const std::vector<std::string>& argv);
+
+/// Absolute path of a binary installed beside the running one.
+std::string siblingBinary(const std::string& name);
+
+}  // namespace tomomap::cli

@@ -1,0 +1,229 @@
+// `tomomap eval SUITE`: every pair of a suite through every method, each run as
+// its own process (so time and peak memory are that method's alone), rows
+// written as they finish, and a Markdown summary at the end.
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "child_process.hpp"
+#include "commands.hpp"
+#include "exit_codes.hpp"
+#include "suite.hpp"
+#include "synth_files.hpp"
+
+namespace tomomap::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Bytes one feature costs on the wire: a 32-byte ORB descriptor and x, y
+/// quantised to the grid as two 16-bit integers. Plus 8 bytes per slice header.
+constexpr double kBytesPerFeature = 36, kBytesPerSlice = 8, kBytesPerRawPoint = 12;
+
+struct Row {
+  std::string pair, noise, method;
+  int exit_code = -1;
+  bool reliable = false, success = false;
+  double translation_error = NAN, yaw_error = NAN, seconds = 0, peak_rss_mb = 0;
+  double features = 0, slices = 0, payload_bytes = 0, raw_bytes = 0;
+  std::string note;
+};
+
+const char* kCsvHeader =
+    "pair,noise,method,exit_code,reliable,success,translation_error_m,yaw_error_rad,wall_s,peak_rss_mb,features,"
+    "feature_payload_bytes,raw_map_bytes,note";
+
+std::string csv(const Row& r) {
+  std::ostringstream o;
+  o << std::setprecision(6) << '"' << r.pair << "\"," << r.noise << ',' << r.method << ',' << r.exit_code << ','
+    << r.reliable << ',' << r.success << ',' << r.translation_error << ',' << r.yaw_error << ',' << r.seconds << ','
+    << r.peak_rss_mb << ',' << r.features << ',' << r.payload_bytes << ',' << r.raw_bytes << ",\"" << r.note << '"';
+  return o.str();
+}
+
+Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratch, int threads) {
+  Row row;
+  row.pair = p.name;
+  row.noise = p.noise;
+  row.method = method;
+  const std::string json = (scratch / "result.json").string();
+  fs::remove(json);
+  std::vector<std::string> argv;
+  if (method == "tomomap")
+    argv = {siblingBinary("tomomap"), "match", "-q"};
+  else
+    argv = {siblingBinary("tomomap-baseline")};
+  for (const auto& a : {p.target, p.source, std::string("--grid"), std::to_string(p.grid), std::string("--json"), json,
+                        std::string("--gt-target"), p.gt_target, std::string("--gt-source"), p.gt_source,
+                        std::string("-j"), std::to_string(threads)})
+    argv.push_back(a);
+  const ChildRun run = runChild(argv);
+  row.exit_code = run.exit_code;
+  row.seconds = run.seconds;
+  row.peak_rss_mb = run.peak_rss_mb;
+  std::ifstream in(json);
+  if (run.exit_code > 1 || !in) {
+    row.note = run.output.substr(0, run.output.find('\n'));
+    return row;
+  }
+  const auto j = nlohmann::json::parse(in);
+  row.reliable = j.value("reliable", false);
+  if (j.contains("error")) {
+    row.translation_error = j["error"]["translation"];
+    row.yaw_error = j["error"]["yaw"];
+    row.success = j["error"]["success"];
+  }
+  if (!row.reliable) row.note = j.value("reason", "");
+  const auto& s = j["slices"];
+  row.features = s.value("target_features", 0.0) + s.value("source_features", 0.0);
+  row.slices = s.value("target", 0.0) + s.value("source", 0.0);
+  row.raw_bytes = kBytesPerRawPoint * (j.value("target_points", 0.0) + j.value("source_points", 0.0));
+  if (method == "tomomap") row.payload_bytes = kBytesPerFeature * row.features + kBytesPerSlice * row.slices;
+  return row;
+}
+
+double percentile(std::vector<double> v, double q) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<size_t>(std::lround(q * static_cast<double>(v.size() - 1)))];
+}
+
+std::string summary(const std::string& suite, const std::vector<Row>& rows) {
+  std::map<std::pair<std::string, std::string>, std::vector<const Row*>> groups;
+  for (const auto& r : rows) groups[{r.method, r.noise}].push_back(&r);
+  std::ostringstream o;
+  o << std::fixed;
+  o << "## " << suite << "\n\n"
+    << "| method | noise | pairs | success | median t err [m] | p90 t err [m] | median yaw err [rad] | p90 yaw err "
+       "[rad] | median time [s] | peak RSS [MB] | payload / raw map |\n"
+    << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::map<std::string, std::vector<double>> times, rss;
+  for (const auto& [key, g] : groups) {
+    std::vector<double> te, ye, t, m;
+    int ok = 0;
+    double payload = 0, raw = 0;
+    for (const Row* r : g) {
+      ok += r->success;
+      te.push_back(r->success || r->reliable ? r->translation_error : NAN);
+      ye.push_back(r->success || r->reliable ? r->yaw_error : NAN);
+      t.push_back(r->seconds);
+      m.push_back(r->peak_rss_mb);
+      payload += r->payload_bytes;
+      raw += r->raw_bytes;
+      times[key.first].push_back(r->seconds);
+      rss[key.first].push_back(r->peak_rss_mb);
+    }
+    o << "| " << key.first << " | " << key.second << " | " << g.size() << " | " << ok << "/" << g.size() << " | "
+      << std::setprecision(3) << percentile(te, 0.5) << " | " << percentile(te, 0.9) << " | " << std::setprecision(4)
+      << percentile(ye, 0.5) << " | " << percentile(ye, 0.9) << " | " << std::setprecision(2) << percentile(t, 0.5)
+      << " | " << std::setprecision(0) << percentile(m, 1.0) << " | ";
+    if (payload > 0 && raw > 0)
+      o << std::setprecision(1) << 100.0 * payload / raw << " %";
+    else
+      o << "–";
+    o << " |\n";
+  }
+  if (times.count("tomomap") && times.count("fpfh-ransac")) {
+    o << std::setprecision(1) << "\nfpfh-ransac / tomomap: median time "
+      << percentile(times["fpfh-ransac"], 0.5) / percentile(times["tomomap"], 0.5) << "x, peak memory "
+      << percentile(rss["fpfh-ransac"], 1.0) / percentile(rss["tomomap"], 1.0) << "x\n";
+  }
+  return o.str();
+}
+
+struct EvalOptions {
+  std::string suite, out = "eval-out";
+  std::vector<std::string> methods;
+  int threads = 0;
+};
+
+int runEval(const EvalOptions& o) {
+  Suite suite = loadSuite(o.suite);
+  if (!o.methods.empty()) suite.methods = o.methods;
+  for (const auto& w : suite.warnings) std::cerr << "tomomap eval: warning: " << w << "\n";
+  const fs::path out(o.out);
+  fs::create_directories(out / "worlds");
+
+  for (const auto& y : suite.synth)
+    for (const auto& noise : y.noise)
+      for (int64_t seed : y.seeds) {
+        synth::SceneParams sp;
+        sp.type = synth::parseWorldType(y.world);
+        sp.seed = static_cast<uint64_t>(seed);
+        sp.scale = y.scale;
+        const std::string name = y.world + "-" + noise + "-" + std::to_string(seed);
+        std::cerr << "generating " << name << "\n";
+        const GeneratedWorld w = writeSynthWorld(sp, synth::noiseLevel(noise), (out / "worlds" / name).string());
+        suite.pairs.push_back({name, w.maps[0], w.maps[1], w.poses[0], w.poses[1], w.grid, noise});
+      }
+
+  std::ofstream rows_csv(out / "rows.csv");
+  std::ofstream rows_json(out / "rows.jsonl");
+  rows_csv << kCsvHeader << "\n";
+  std::vector<Row> rows;
+  const size_t total = suite.pairs.size() * suite.methods.size();
+  for (const auto& p : suite.pairs)
+    for (const auto& m : suite.methods) {
+      Row r = runOne(p, m, out, o.threads);
+      rows.push_back(r);
+      // Written as they finish: an interrupted run keeps every finished row.
+      rows_csv << csv(r) << std::endl;
+      rows_json << nlohmann::json{{"pair", r.pair},
+                                  {"noise", r.noise},
+                                  {"method", r.method},
+                                  {"exit_code", r.exit_code},
+                                  {"reliable", r.reliable},
+                                  {"success", r.success},
+                                  {"translation_error_m", std::isnan(r.translation_error)
+                                                              ? nlohmann::json()
+                                                              : nlohmann::json(r.translation_error)},
+                                  {"yaw_error_rad",
+                                   std::isnan(r.yaw_error) ? nlohmann::json() : nlohmann::json(r.yaw_error)},
+                                  {"wall_s", r.seconds},
+                                  {"peak_rss_mb", r.peak_rss_mb},
+                                  {"features", r.features},
+                                  {"feature_payload_bytes", r.payload_bytes},
+                                  {"raw_map_bytes", r.raw_bytes},
+                                  {"note", r.note}}
+                       .dump()
+                << std::endl;
+      std::cerr << "[" << rows.size() << "/" << total << "] " << std::left << std::setw(28) << p.name << std::setw(12)
+                << m
+                << (r.success          ? "success"
+                    : r.exit_code == 1 ? "no match"
+                    : r.exit_code > 1  ? "error"
+                                       : "FAILED")
+                << std::fixed << std::setprecision(3) << "  t " << r.translation_error << " m  yaw " << r.yaw_error
+                << " rad  " << std::setprecision(2) << r.seconds << " s  " << std::setprecision(0) << r.peak_rss_mb
+                << " MB" << (r.note.empty() ? "" : "  (" + r.note + ")") << "\n";
+    }
+  const std::string md = summary(suite.name, rows);
+  std::ofstream(out / "summary.md") << md;
+  std::cout << md << "\nrows: " << (out / "rows.csv").string() << ", summary: " << (out / "summary.md").string()
+            << "\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+Command addEvalCommand(CLI::App& app) {
+  auto o = std::make_shared<EvalOptions>();
+  CLI::App* sub = app.add_subcommand("eval", "Run every pair of a suite through tomomap and the FPFH-RANSAC baseline.");
+  sub->add_option("SUITE", o->suite, "suite file (TOML): [[pair]] tables and/or [[synth]] tables")->required();
+  sub->add_option("-o,--out", o->out, "output directory (rows.csv, rows.jsonl, summary.md, worlds/)")
+      ->capture_default_str();
+  sub->add_option("-m,--methods", o->methods, "override the suite's methods (tomomap, fpfh-ransac)")
+      ->check(CLI::IsMember({"tomomap", "fpfh-ransac"}));
+  sub->add_option("-j,--threads", o->threads, "threads per match (0 = all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
+  return {sub, [o] { return runEval(*o); }};
+}
+
+}  // namespace tomomap::cli

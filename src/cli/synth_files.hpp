@@ -1,0 +1,22 @@
+#pragma once
+// Generating a synthetic world to files: used by `synth` and by `eval` suites.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "synth/synth.hpp"
+
+namespace tomomap::cli {
+
+struct GeneratedWorld {
+  double grid = 0;                 ///< grid size to match the maps at [m]
+  std::vector<std::string> maps;   ///< DIR/map_N.pcd
+  std::vector<std::string> poses;  ///< DIR/map_N-gtpose.txt
+  std::vector<size_t> points;      ///< points per map
+};
+
+/// Scans the scene and writes map_N.pcd, map_N-gtpose.txt and scene.json into `dir`.
+GeneratedWorld writeSynthWorld(const synth::SceneParams& params, const synth::NoiseModel& noise, const std::string& dir,
+                               const std::function<void(size_t, size_t)>& progress = {});
+
+}  // namespace tomomap::cli
