@@ -1,0 +1,58 @@
+// `tomomap eval` as a user runs it: suites, errors with line numbers, rows, summary.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "support.hpp"
+
+using namespace tomomap;
+using tomomap::test::runTomomap;
+using tomomap::test::TempDir;
+
+static std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(Eval, SuiteErrorsNameFileLineAndProblem) {
+  TempDir dir;
+  std::ofstream(dir / "syntax.toml") << "name = \"x\"\n[[pair]\ntarget = 1\n";
+  auto r = runTomomap("eval " + (dir / "syntax.toml") + " -o " + (dir / "out"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("syntax.toml:2:"), std::string::npos) << r.output;
+
+  std::ofstream(dir / "method.toml") << "name = \"x\"\nmethods = [\"tomomap\", \"icp\"]\n[[synth]]\nworld = \"indoor\"\n";
+  r = runTomomap("eval " + (dir / "method.toml") + " -o " + (dir / "out"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("method.toml:2:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("unknown method 'icp'"), std::string::npos) << r.output;
+
+  std::ofstream(dir / "key.toml") << "[[synth]]\nworld = \"indoor\"\nseed = [1]\n";
+  r = runTomomap("eval " + (dir / "key.toml") + " -o " + (dir / "out"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("key.toml:3:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("unknown key 'seed'"), std::string::npos) << r.output;
+}
+
+TEST(Eval, MissingMapIsLeftOutAndTheRestRuns) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  const std::string d = test::demoRoom() + "/";
+  std::ofstream(dir / "s.toml") << "name = \"mixed\"\nmethods = [\"tomomap\"]\n"
+                                << "[[pair]]\nname = \"gone\"\ntarget = \"/nonexistent/a.pcd\"\nsource = \"" << d
+                                << "demo-pcd2.pcd\"\ngt_target = \"" << d << "demo-pcd1-gtpose.txt\"\ngt_source = \"" << d
+                                << "demo-pcd2-gtpose.txt\"\n"
+                                << "[[pair]]\nname = \"room\"\ntarget = \"" << d << "demo-pcd1.pcd\"\nsource = \"" << d
+                                << "demo-pcd2.pcd\"\ngt_target = \"" << d << "demo-pcd1-gtpose.txt\"\ngt_source = \"" << d
+                                << "demo-pcd2-gtpose.txt\"\ngrid = 0.05\n";
+  const auto r = runTomomap("eval " + (dir / "s.toml") + " -o " + (dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("pair 'gone' left out"), std::string::npos) << r.output;
+  const std::string rows = slurp(dir / "out/rows.csv");
+  EXPECT_NE(rows.find("\"room\",real,tomomap,0,1,1"), std::string::npos) << rows;
+  const std::string md = slurp(dir / "out/summary.md");
+  EXPECT_NE(md.find("| tomomap | real | 1 | 1/1 |"), std::string::npos) << md;
+}
