@@ -13,12 +13,13 @@ command -v /usr/bin/time >/dev/null || { echo "bench: needs GNU time (apt-get in
 
 median() { sort -n | awk '{a[NR]=$1} END {print (NR%2) ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2}'; }
 
-# bench NAME TARGET SOURCE GRID [extra args]
+# bench NAME TARGET SOURCE GRID [extra args]; MATCH (default: tomomap match) is the command
 bench() {
   local name=$1 target=$2 source=$3 grid=$4; shift 4
+  local cmd=(${MATCH:-$tomomap match})
   local times=() rss=()
   for ((i = 0; i < runs; i++)); do
-    /usr/bin/time -f "%e %M" -o "$work/t" "$tomomap" match "$target" "$source" --grid "$grid" -q "$@" >"$work/out" || true
+    /usr/bin/time -f "%e %M" -o "$work/t" "${cmd[@]}" "$target" "$source" --grid "$grid" "$@" >"$work/out" || true
     read -r t m <"$work/t"
     times+=("$t"); rss+=("$m")
   done
@@ -37,6 +38,9 @@ if [ -f "$demo/demo-pcd1.pcd" ]; then
   bench "demo-room pcd1 -> pcd2 (g 0.05)" "$demo/demo-pcd2.pcd" "$demo/demo-pcd1.pcd" 0.05 \
     --gt-target "$demo/demo-pcd2-gtpose.txt" --gt-source "$demo/demo-pcd1-gtpose.txt"
   bench "demo-room, 1 thread" "$demo/demo-pcd1.pcd" "$demo/demo-pcd2.pcd" 0.05 -j 1
+  MATCH="${BUILD_DIR:-build}/src/cli/tomomap-baseline" bench "demo-room pcd2 -> pcd1, FPFH-RANSAC" \
+    "$demo/demo-pcd1.pcd" "$demo/demo-pcd2.pcd" 0.05 \
+    --gt-target "$demo/demo-pcd1-gtpose.txt" --gt-source "$demo/demo-pcd2-gtpose.txt"
 else
   echo "demo-room not found at $demo: skipped"
 fi
