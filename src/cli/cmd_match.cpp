@@ -37,9 +37,7 @@ int runMatch(const MatchOptions& o) {
   const MapFeatures source = describe(o.source, "source");
   if (!o.quiet) std::cout << "grid " << o.params.grid << " m\n";
   MatchResult r = matchFeatures(target, source, o.params, terminalProgress(o.progress || stderrIsTerminal()));
-  r.timings.voxel = timings.voxel;
-  r.timings.slicing = timings.slicing;
-  r.timings.features = timings.features;
+  r.timings.takeDescription(timings);
   return report(r, P_target, P_source, o.params.grid, o.json, false, sizes);
 }
 

@@ -29,9 +29,9 @@ int runSynth(const SynthOptions& o) {
   if (o.yaw_sigma) noise.pose_yaw = *o.yaw_sigma;
   if (o.range_sigma) noise.range = *o.range_sigma;
 
-  const bool show = o.progress || stderrIsTerminal();
-  const GeneratedWorld w = writeSynthWorld(sp, noise, o.out, [show](size_t done, size_t total) {
-    if (show && (done % 16 == 0 || done == total)) terminalProgress(true)("scans", done, total);
+  const Progress bar = terminalProgress(o.progress || stderrIsTerminal());
+  const GeneratedWorld w = writeSynthWorld(sp, noise, o.out, [&bar](size_t done, size_t total) {
+    if (bar && (done % 16 == 0 || done == total)) bar("scans", done, total);
   });
   for (size_t i = 0; i < w.maps.size(); ++i) std::cout << w.maps[i] << "  " << w.points[i] << " points\n";
   std::cout << "match with: tomomap match " << w.maps[0] << " " << w.maps.back() << " --grid " << w.grid

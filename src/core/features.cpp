@@ -1,6 +1,7 @@
 #include "features.hpp"
 
 #include <opencv2/features2d.hpp>
+#include <utility>
 
 namespace tomomap {
 
@@ -10,7 +11,7 @@ size_t MapFeatures::featureCount() const {
   return n;
 }
 
-MapFeatures extractFeatures(const SliceStack& stack, const FeatureParams& params) {
+MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params) {
   MapFeatures out;
   out.grid = stack.grid.cell;
   out.z_min = stack.grid.z_min;
@@ -37,7 +38,7 @@ MapFeatures extractFeatures(const SliceStack& stack, const FeatureParams& params
       sf.keypoints.push_back(stack.grid.toMetres(kp.pt.x - static_cast<float>(params.pad),
                                                  kp.pt.y - static_cast<float>(params.pad)));
   }
-  out.occupancy = stack;
+  out.occupancy = std::move(stack);
   for (auto& sf : per_slice)
     if (!sf.keypoints.empty()) out.slices.push_back(std::move(sf));
   return out;

@@ -32,7 +32,8 @@ struct MapFeatures {
   size_t featureCount() const;
 };
 
-/// Detects ORB on every non-empty slice. Parallel over slices.
-MapFeatures extractFeatures(const SliceStack& stack, const FeatureParams& params = {});
+/// Detects ORB on every non-empty slice. Parallel over slices. The stack moves
+/// into the result's `occupancy` (pass a copy to keep your own).
+MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params = {});
 
 }  // namespace tomomap

@@ -65,10 +65,10 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   const Points filtered = voxelFilter(map, params.grid);
   t.voxel += secondsSince(t0);
   t0 = Clock::now();
-  const SliceStack stack = makeSlices(filtered, params.grid);
+  SliceStack stack = makeSlices(filtered, params.grid);
   t.slicing += secondsSince(t0);
   t0 = Clock::now();
-  MapFeatures f = extractFeatures(stack, params.features);
+  MapFeatures f = extractFeatures(std::move(stack), params.features);
   t.features += secondsSince(t0);
   return f;
 }
@@ -225,9 +225,7 @@ MatchResult matchMaps(const Points& target, const Points& source, const MatchPar
   const MapFeatures fs = describeMap(source, params, &t);
   if (progress) progress("features", 2, 2);
   MatchResult r = matchFeatures(ft, fs, params, progress);
-  r.timings.voxel = t.voxel;
-  r.timings.slicing = t.slicing;
-  r.timings.features = t.features;
+  r.timings.takeDescription(t);
   return r;
 }
 

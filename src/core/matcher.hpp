@@ -27,6 +27,12 @@ struct MatchParams {
 struct StageTimings {
   double voxel = 0, slicing = 0, features = 0, pair_matching = 0, consensus = 0, refinement = 0;
   double total() const { return voxel + slicing + features + pair_matching + consensus + refinement; }
+  /// Takes the map-description stages (as describeMap fills them) from `d`.
+  void takeDescription(const StageTimings& d) {
+    voxel = d.voxel;
+    slicing = d.slicing;
+    features = d.features;
+  }
 };
 
 struct MatchResult {
