@@ -22,40 +22,30 @@ struct Described {
 
 Described describe(const Points& map, const FpfhParams& p) {
   const double g = p.grid;
-  Described d;
-  pcl::PointCloud<pcl::PointXYZ>::Ptr dense(new pcl::PointCloud<pcl::PointXYZ>);
-  for (const auto& q : voxelFilter(map, g)) dense->push_back({q.x(), q.y(), q.z()});
-  // Normals from the grid-filtered map; keypoints are a coarser voxel set.
+  // The usual FPFH-RANSAC pipeline: one voxel-downsampled cloud serves as
+  // keypoints and as the surface for normals and descriptors.
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+  for (const auto& q : voxelFilter(map, p.keypoint_cells * g)) cloud->push_back({q.x(), q.y(), q.z()});
   pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::PointNormal> ne;
   if (p.threads > 0) ne.setNumberOfThreads(static_cast<unsigned>(p.threads));
   ne.setRadiusSearch(p.normal_radius_cells * g);
-  Cloud::Ptr with_normals(new Cloud);
-  ne.setInputCloud(dense);
-  ne.compute(*with_normals);
-  for (size_t i = 0; i < dense->size(); ++i) {
-    (*with_normals)[i].x = (*dense)[i].x;
-    (*with_normals)[i].y = (*dense)[i].y;
-    (*with_normals)[i].z = (*dense)[i].z;
-  }
-  Points kp_src;
-  for (const auto& q : *dense) kp_src.emplace_back(q.x, q.y, q.z);
-  // Keypoint = the dense point nearest each coarse voxel centroid, so it keeps a normal.
-  pcl::KdTreeFLANN<pcl::PointNormal> tree;
-  tree.setInputCloud(with_normals);
-  std::vector<int> idx(1);
-  std::vector<float> d2(1);
-  for (const auto& c : voxelFilter(kp_src, p.keypoint_cells * g)) {
-    pcl::PointNormal q;
-    q.x = c.x(); q.y = c.y(); q.z = c.z();
-    if (tree.nearestKSearch(q, 1, idx, d2) == 1 && std::isfinite((*with_normals)[static_cast<size_t>(idx[0])].normal_x))
-      d.keypoints->push_back((*with_normals)[static_cast<size_t>(idx[0])]);
+  Cloud with_normals;
+  ne.setInputCloud(cloud);
+  ne.compute(with_normals);
+  Described d;
+  for (size_t i = 0; i < cloud->size(); ++i) {
+    pcl::PointNormal q = with_normals[i];
+    if (!std::isfinite(q.normal_x)) continue;  // too few neighbours for a normal
+    q.x = (*cloud)[i].x;
+    q.y = (*cloud)[i].y;
+    q.z = (*cloud)[i].z;
+    d.keypoints->push_back(q);
   }
   pcl::FPFHEstimationOMP<pcl::PointNormal, pcl::PointNormal, pcl::FPFHSignature33> fe;
   if (p.threads > 0) fe.setNumberOfThreads(static_cast<unsigned>(p.threads));
   fe.setRadiusSearch(p.feature_radius_cells * g);
   fe.setInputCloud(d.keypoints);
-  fe.setSearchSurface(with_normals);
-  fe.setInputNormals(with_normals);
+  fe.setInputNormals(d.keypoints);
   fe.compute(*d.features);
   return d;
 }

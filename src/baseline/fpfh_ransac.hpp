@@ -8,7 +8,7 @@ namespace tomomap::baseline {
 
 struct FpfhParams {
   double grid = 0.05;                ///< the pair's grid size g [m]; everything below scales with it
-  double keypoint_cells = 2.0;       ///< keypoints: voxel centroids at this many g
+  double keypoint_cells = 2.0;       ///< keypoints and descriptor surface: voxel centroids at this many g
   double normal_radius_cells = 4.0;  ///< normal estimation radius [g]
   double feature_radius_cells = 10.0;  ///< FPFH radius [g]
   double inlier_cells = 3.0;         ///< correspondence distance for RANSAC inliers [g]

@@ -24,6 +24,12 @@ int main(int argc, char** argv) {
   app.add_option("-g,--grid", p.grid, "grid size g [m]; radii scale with it")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app.add_option("--keypoint-cells", p.keypoint_cells, "keypoint spacing [g]: fewer keypoints run faster")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 100.0));
+  app.add_option("--iterations", p.max_iterations, "RANSAC iterations at most")
+      ->capture_default_str()
+      ->check(CLI::Range(100, 10000000));
   app.add_option("--json", json, "also write the result as JSON to FILE");
   app.add_option("--gt-target", gt_target, "target's ground-truth pose file (3x4 row-major)");
   app.add_option("--gt-source", gt_source, "source's ground-truth pose file (3x4 row-major)");

@@ -15,6 +15,7 @@
 #include "exit_codes.hpp"
 #include "suite.hpp"
 #include "synth_files.hpp"
+#include "viz/box_plot.hpp"
 
 namespace tomomap::cli {
 namespace {
@@ -29,7 +30,7 @@ struct Row {
   std::string pair, noise, method;
   int exit_code = -1;
   bool reliable = false, success = false;
-  double translation_error = NAN, yaw_error = NAN, seconds = 0, peak_rss_mb = 0;
+  double grid = 0, translation_error = NAN, yaw_error = NAN, seconds = 0, peak_rss_mb = 0;
   double features = 0, slices = 0, payload_bytes = 0, raw_bytes = 0;
   std::string note;
 };
@@ -51,6 +52,7 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   row.pair = p.name;
   row.noise = p.noise;
   row.method = method;
+  row.grid = p.grid;
   const std::string json = (scratch / "result.json").string();
   fs::remove(json);
   std::vector<std::string> argv;
@@ -85,6 +87,13 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   row.raw_bytes = kBytesPerRawPoint * (j.value("target_points", 0.0) + j.value("source_points", 0.0));
   if (method == "tomomap") row.payload_bytes = kBytesPerFeature * row.features + kBytesPerSlice * row.slices;
   return row;
+}
+
+/// 0.5 -> "0.5", 2 -> "2": for names.
+std::string shortNumber(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
 }
 
 double percentile(std::vector<double> v, double q) {
@@ -137,6 +146,32 @@ std::string summary(const std::string& suite, const std::vector<Row>& rows) {
   return o.str();
 }
 
+/// The paper's figures: errors, time and memory per method and noise level.
+/// Errors are in grid cells and degrees so one success threshold fits pairs of
+/// any grid size; failed runs count at their error (a no-match has none).
+cv::Mat boxPlots(const std::vector<Row>& rows, const std::vector<std::string>& methods) {
+  std::vector<std::string> noise;
+  for (const char* n : {"none", "low", "high", "real"})
+    for (const auto& r : rows)
+      if (r.noise == n) {
+        noise.push_back(n);
+        break;
+      }
+  viz::BoxPanel t{"translation error", "error / grid size [cells]", true, 5.0, "success limit 5 cells", noise, methods, {}};
+  viz::BoxPanel y{"yaw error", "error [deg]", true, 10.0, "success limit 10 deg", noise, methods, {}};
+  viz::BoxPanel w{"wall time per pair", "time [s]", true, NAN, "", noise, methods, {}};
+  viz::BoxPanel m{"peak memory per pair", "peak RSS [MB]", false, NAN, "", noise, methods, {}};
+  for (const auto& r : rows) {
+    const std::pair<std::string, std::string> key{r.noise, r.method};
+    t.values[key].push_back(r.translation_error / r.grid);
+    y.values[key].push_back(r.yaw_error * 180.0 / kPi);
+    w.values[key].push_back(r.seconds);
+    m.values[key].push_back(r.peak_rss_mb);
+  }
+  return viz::stack({viz::stack({drawBoxPanel(t), drawBoxPanel(y)}, false),
+                     viz::stack({drawBoxPanel(w), drawBoxPanel(m)}, false)});
+}
+
 struct EvalOptions {
   std::string suite, out = "eval-out";
   std::vector<std::string> methods;
@@ -148,7 +183,9 @@ int runEval(const EvalOptions& o) {
   if (!o.methods.empty()) suite.methods = o.methods;
   for (const auto& w : suite.warnings) std::cerr << "tomomap eval: warning: " << w << "\n";
   const fs::path out(o.out);
-  fs::create_directories(out / "worlds");
+  std::error_code ec;
+  fs::create_directories(out / "worlds", ec);
+  if (ec) throw InputError(o.out + ": cannot create the output folder: " + ec.message());
 
   for (const auto& y : suite.synth)
     for (const auto& noise : y.noise)
@@ -157,10 +194,12 @@ int runEval(const EvalOptions& o) {
         sp.type = synth::parseWorldType(y.world);
         sp.seed = static_cast<uint64_t>(seed);
         sp.scale = y.scale;
-        const std::string name = y.world + "-" + noise + "-" + std::to_string(seed);
+        std::string name = y.world + "-" + noise + "-" + std::to_string(seed);
+        if (y.scale != 1.0) name += "-x" + shortNumber(y.scale);
+        if (y.grid > 0) name += "-g" + shortNumber(y.grid);
         std::cerr << "generating " << name << "\n";
         const GeneratedWorld w = writeSynthWorld(sp, synth::noiseLevel(noise), (out / "worlds" / name).string());
-        suite.pairs.push_back({name, w.maps[0], w.maps[1], w.poses[0], w.poses[1], w.grid, noise});
+        suite.pairs.push_back({name, w.maps[0], w.maps[1], w.poses[0], w.poses[1], y.grid > 0 ? y.grid : w.grid, noise});
       }
 
   std::ofstream rows_csv(out / "rows.csv");
@@ -205,8 +244,9 @@ int runEval(const EvalOptions& o) {
     }
   const std::string md = summary(suite.name, rows);
   std::ofstream(out / "summary.md") << md;
+  viz::writePng((out / "boxplots.png").string(), boxPlots(rows, suite.methods));
   std::cout << md << "\nrows: " << (out / "rows.csv").string() << ", summary: " << (out / "summary.md").string()
-            << "\n";
+            << ", plots: " << (out / "boxplots.png").string() << "\n";
   return kExitOk;
 }
 
@@ -216,7 +256,7 @@ Command addEvalCommand(CLI::App& app) {
   auto o = std::make_shared<EvalOptions>();
   CLI::App* sub = app.add_subcommand("eval", "Run every pair of a suite through tomomap and the FPFH-RANSAC baseline.");
   sub->add_option("SUITE", o->suite, "suite file (TOML): [[pair]] tables and/or [[synth]] tables")->required();
-  sub->add_option("-o,--out", o->out, "output directory (rows.csv, rows.jsonl, summary.md, worlds/)")
+  sub->add_option("-o,--out", o->out, "output directory (rows.csv, rows.jsonl, summary.md, boxplots.png, worlds/)")
       ->capture_default_str();
   sub->add_option("-m,--methods", o->methods, "override the suite's methods (tomomap, fpfh-ransac)")
       ->check(CLI::IsMember({"tomomap", "fpfh-ransac"}));

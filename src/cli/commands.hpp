@@ -14,5 +14,6 @@ struct Command {
 Command addMatchCommand(CLI::App& app);
 Command addSynthCommand(CLI::App& app);
 Command addEvalCommand(CLI::App& app);
+Command addVizCommand(CLI::App& app);
 
 }  // namespace tomomap::cli

@@ -80,6 +80,7 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
   else
     j["reason"] = r.reason;
   j["quality"] = {{"support", r.support},
+                  {"height_offset_slices", r.height_offset},
                   {"runner_up_support", r.runner_up_support},
                   {"inliers", r.inliers},
                   {"inlier_spread", {r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z()}}};

@@ -110,7 +110,7 @@ Suite loadSuite(const std::string& path) {
     for (const auto& e : *a) {
       const toml::table* t = e.as_table();
       if (!t) fail(path, e.source(), "each [[synth]] must be a table");
-      checkKeys(path, *t, {"world", "seeds", "noise", "scale"}, "[[synth]]");
+      checkKeys(path, *t, {"world", "seeds", "noise", "scale", "grid"}, "[[synth]]");
       SuiteSynth y;
       y.world = text(path, *t, "world", "[[synth]]");
       if (y.world != "indoor" && y.world != "outdoor")
@@ -121,6 +121,7 @@ Suite loadSuite(const std::string& path) {
         if (n != "none" && n != "low" && n != "high")
           fail(path, t->get("noise")->source(), "unknown noise level '" + n + "'");
       y.scale = number(path, *t, "scale", 1.0);
+      y.grid = number(path, *t, "grid", 0.0);
       s.synth.push_back(y);
     }
   }

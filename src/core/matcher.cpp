@@ -20,19 +20,6 @@ double secondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-/// Mutual nearest neighbours in Hamming distance, as source -> target positions.
-Correspondences mutualMatches(const SliceFeatures& target, const SliceFeatures& source) {
-  const auto matches = mutualNearest(source.descriptors, target.descriptors);
-  Correspondences c;
-  c.source.reserve(matches.size());
-  c.target.reserve(matches.size());
-  for (const auto& [s, t] : matches) {
-    c.source.push_back(source.keypoints[static_cast<size_t>(s)].cast<double>());
-    c.target.push_back(target.keypoints[static_cast<size_t>(t)].cast<double>());
-  }
-  return c;
-}
-
 /// One slice pair's outcome; `ok` is false when it gave no estimate.
 struct PairEstimate {
   bool ok = false;
@@ -57,6 +44,18 @@ RansacParams ransacParams(const MatchParams& p) {
 }
 
 }  // namespace
+
+Correspondences matchSlices(const SliceFeatures& target, const SliceFeatures& source) {
+  const auto matches = mutualNearest(source.descriptors, target.descriptors);
+  Correspondences c;
+  c.source.reserve(matches.size());
+  c.target.reserve(matches.size());
+  for (const auto& [s, t] : matches) {
+    c.source.push_back(source.keypoints[static_cast<size_t>(s)].cast<double>());
+    c.target.push_back(target.keypoints[static_cast<size_t>(t)].cast<double>());
+  }
+  return c;
+}
 
 MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings) {
   StageTimings local;
@@ -103,7 +102,7 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
 #pragma omp parallel for schedule(dynamic, 4)
   for (long long k = 0; k < static_cast<long long>(nt * ns); ++k) {
     const size_t a = static_cast<size_t>(k) / ns, b = static_cast<size_t>(k) % ns;
-    const Correspondences c = mutualMatches(target.slices[a], source.slices[b]);
+    const Correspondences c = matchSlices(target.slices[a], source.slices[b]);
     if (c.size() >= static_cast<size_t>(params.min_matches)) {
       // Seeded per pair so results do not depend on thread scheduling.
       if (auto est = ransacRigid2D(c, ransac, 0x9E3779B97F4A7C15ull * (a + 1) + b))
@@ -153,6 +152,11 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
     if (std::abs(s.offset - best->offset) > 1)
       r.runner_up_support = std::max(r.runner_up_support, static_cast<int>(s.consensus.support()));
   r.support = static_cast<int>(best->consensus.support());
+  r.height_offset = best->offset;
+  for (size_t k : best->consensus.supporters)
+    r.supporters.push_back({target.slices[k / ns].index, source.slices[k % ns].index, pairs[k].inliers});
+  std::stable_sort(r.supporters.begin(), r.supporters.end(),
+                   [](const SupportingPair& x, const SupportingPair& y) { return x.inliers > y.inliers; });
 
   // Refinement: one least-squares fit over every correspondence of the winning
   // offset and its neighbours (walls look alike one slice up or down) that agrees
@@ -164,7 +168,7 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   for (size_t a = 0; a < nt; ++a)
     for (size_t b = 0; b < ns; ++b) {
       if (std::abs(target.slices[a].index - source.slices[b].index - best->offset) > 1) continue;
-      const Correspondences c = mutualMatches(target.slices[a], source.slices[b]);
+      const Correspondences c = matchSlices(target.slices[a], source.slices[b]);
       all.source.insert(all.source.end(), c.source.begin(), c.source.end());
       all.target.insert(all.target.end(), c.target.begin(), c.target.end());
       heights.insert(heights.end(), c.size(), target.sliceHeight(target.slices[a].index));

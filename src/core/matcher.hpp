@@ -35,6 +35,12 @@ struct StageTimings {
   }
 };
 
+/// One slice pair that agreed with the winning consensus.
+struct SupportingPair {
+  int target_slice = 0, source_slice = 0;  ///< slice indices within their maps
+  uint32_t inliers = 0;                    ///< RANSAC inliers of that pair's own estimate
+};
+
 struct MatchResult {
   /// False means "no reliable match": T_target_source is then meaningless and
   /// must not be used; `reason` says why.
@@ -44,6 +50,8 @@ struct MatchResult {
 
   int support = 0;                ///< agreeing slice pairs at the winning height offset
   int runner_up_support = 0;      ///< best support more than one step away from the winner
+  int height_offset = 0;          ///< winning target slice index - source slice index
+  std::vector<SupportingPair> supporters;  ///< the slice pairs behind `support`, most inliers first
   size_t inliers = 0;             ///< feature correspondences consistent with the result
   Eigen::Vector3d inlier_spread = Eigen::Vector3d::Zero();  ///< std. dev. of inliers in target x, y, z [m]
 
@@ -55,6 +63,10 @@ struct MatchResult {
 
 /// Called with (stage name, done, total) as work advances; may be empty.
 using Progress = std::function<void(const char*, size_t, size_t)>;
+
+/// Mutual nearest neighbours in Hamming distance between two slices' descriptors,
+/// as matched map-frame positions (source -> target).
+Correspondences matchSlices(const SliceFeatures& target, const SliceFeatures& source);
 
 /// Finds T_target_source from two feature stacks of the same grid size.
 MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source,

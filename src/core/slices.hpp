@@ -40,7 +40,7 @@ struct SliceStack {
 constexpr int kMaxImageSide = 16384;
 
 /// Slices `points` (already voxel-filtered at `cell`). Slices with fewer
-/// occupied cells than width + height are kept empty (too sparse for ORB);
+/// occupied cells than (width + height) / 2 are kept empty (too sparse for ORB);
 /// empty slices at the bottom and top are trimmed. Throws InputError if the
 /// raster would exceed kMaxImageSide.
 SliceStack makeSlices(const Points& points, double cell);

@@ -3,6 +3,7 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "support.hpp"
 
@@ -167,4 +168,41 @@ TEST(Cli, FpfhRansacBaselineRunsOnTheSamePair) {
   EXPECT_TRUE(j["error"]["success"].get<bool>()) << j.dump();
   EXPECT_EQ(test::runBinary(TOMOMAP_BASELINE_BIN, "a.pcd b.pcd --grid 0").exit_code, 2);
   EXPECT_EQ(test::runBinary(TOMOMAP_BASELINE_BIN, "/nonexistent.pcd b.pcd").exit_code, 2);
+}
+
+namespace {
+
+/// Pixels of exactly this BGR colour.
+int countColour(const cv::Mat& img, const cv::Vec3b& c) {
+  int n = 0;
+  for (int v = 0; v < img.rows; ++v)
+    for (int u = 0; u < img.cols; ++u) n += img.at<cv::Vec3b>(v, u) == c;
+  return n;
+}
+
+}  // namespace
+
+TEST(Cli, VizDrawsAnAlignedOverlayAndTheWinningSlicePairs) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  std::string args = demoMatchArgs();
+  args.replace(0, 5, "viz");
+  const auto r = runTomomap(args + " -o " + (dir / "pics") + " --pairs 2");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("overlay.png"), std::string::npos) << r.output;
+  const cv::Mat overlay = cv::imread(dir / "pics/overlay.png");
+  const cv::Mat pairs = cv::imread(dir / "pics/slice-pairs.png");
+  ASSERT_FALSE(overlay.empty());
+  ASSERT_FALSE(pairs.empty());
+  EXPECT_GE(overlay.cols, 800);
+  // Aligned maps mostly coincide: the "both" colour outweighs target-only cells.
+  const int both = countColour(overlay, {60, 40, 40}), target_only = countColour(overlay, {178, 114, 0});
+  EXPECT_GT(both, target_only) << "both " << both << ", target only " << target_only;
+  // Two slice pairs, each with green inlier lines.
+  EXPECT_GT(pairs.rows, 2 * 100);
+  EXPECT_GT(countColour(pairs, {40, 170, 40}), 100);
+
+  // An unwritable output folder is bad input, reported as such.
+  const auto bad = runTomomap(args + " -o /proc/nope");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
 }

@@ -1,7 +1,10 @@
 // `tomomap eval` as a user runs it: suites, errors with line numbers, rows, summary.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
+#include <iostream>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "support.hpp"
@@ -55,4 +58,23 @@ TEST(Eval, MissingMapIsLeftOutAndTheRestRuns) {
   EXPECT_NE(rows.find("\"room\",real,tomomap,0,1,1"), std::string::npos) << rows;
   const std::string md = slurp(dir / "out/summary.md");
   EXPECT_NE(md.find("| tomomap | real | 1 | 1/1 |"), std::string::npos) << md;
+}
+
+// The CI suite shipped with the project: both world types, three noise levels,
+// tomomap next to the FPFH-RANSAC baseline. Asserts tomomap's success rate;
+// timings are reported, never asserted.
+TEST(Eval, QuickSuiteSucceedsAndDrawsBoxPlots) {
+  TempDir dir;
+  const auto r = runTomomap("eval " + std::string(TOMOMAP_SOURCE_DIR) + "/tests/suites/quick.toml -o " + (dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::cout << r.output;
+  for (const char* noise : {"none", "low", "high"})
+    EXPECT_NE(r.output.find(std::string("| tomomap | ") + noise + " | 2 | 2/2 |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("| fpfh-ransac | high | 2 |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("fpfh-ransac / tomomap: median time"), std::string::npos) << r.output;
+  const std::string rows = slurp(dir / "out/rows.csv");
+  EXPECT_EQ(std::count(rows.begin(), rows.end(), '\n'), 1 + 12) << rows;
+  const cv::Mat plots = cv::imread(dir / "out/boxplots.png");
+  ASSERT_FALSE(plots.empty());
+  EXPECT_GT(plots.cols, 1000);
 }

@@ -1,0 +1,48 @@
+#include "match_files.hpp"
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "core/map_io.hpp"
+#include "progress.hpp"
+
+namespace tomomap::cli {
+
+MatchedFiles matchFiles(const MatchFilesOptions& o) {
+  if (!(o.params.grid > 0.0)) throw InputError("grid size must be positive");
+  requireBothOrNeither(o.gt_target, o.gt_source);
+  MatchedFiles m;
+  if (!o.gt_target.empty()) m.P_target = loadPoseFile(o.gt_target);
+  if (!o.gt_source.empty()) m.P_source = loadPoseFile(o.gt_source);
+  StageTimings timings;
+  auto describe = [&](const std::string& path, const char* role) {
+    const Points map = loadMap(path);
+    m.sizes[std::string(role) + "_points"] = map.size();
+    if (!o.quiet) std::cout << role << " " << path << " (" << map.size() << " points)\n";
+    return describeMap(map, o.params, &timings);
+  };
+  m.target = describe(o.target, "target");
+  m.source = describe(o.source, "source");
+  if (!o.quiet) std::cout << "grid " << o.params.grid << " m\n";
+  m.result = matchFeatures(m.target, m.source, o.params, terminalProgress(o.progress || stderrIsTerminal()));
+  m.result.timings.takeDescription(timings);
+  return m;
+}
+
+void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
+  sub.add_option("-g,--grid", o.params.grid, "grid size g [m]: voxel, pixel and slice size")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sub.add_option("--gt-target", o.gt_target, "target's ground-truth pose file (3x4 row-major)");
+  sub.add_option("--gt-source", o.gt_source, "source's ground-truth pose file (3x4 row-major)");
+  sub.add_option("--features", o.params.features.max_features, "ORB keypoints kept per slice")
+      ->capture_default_str()
+      ->check(CLI::Range(10, 100000));
+  sub.add_option("-j,--threads", o.params.threads, "worker threads (0 = all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
+  sub.add_flag("--progress", o.progress, "show progress even when stderr is not a terminal");
+  sub.add_flag("-q,--quiet", o.quiet, "print only the result");
+}
+
+}  // namespace tomomap::cli

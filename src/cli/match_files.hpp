@@ -1,0 +1,33 @@
+#pragma once
+// Loading, describing and matching two map files: what `match` and `viz` share.
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+
+#include "core/matcher.hpp"
+#include "report.hpp"
+
+namespace tomomap::cli {
+
+struct MatchFilesOptions {
+  std::string target, source, gt_target, gt_source;
+  MatchParams params;
+  bool progress = false, quiet = false;
+};
+
+struct MatchedFiles {
+  MapFeatures target, source;
+  MatchResult result;
+  std::optional<Eigen::Matrix4d> P_target, P_source;  ///< ground truth, when given
+  nlohmann::json sizes;                                ///< target_points, source_points
+};
+
+/// Reads the ground truth first (so a bad pose file fails before minutes of
+/// work), then each map in turn (its raw points are dropped once described,
+/// which halves peak memory on large maps), then matches.
+MatchedFiles matchFiles(const MatchFilesOptions& o);
+
+/// Adds --grid, --gt-target, --gt-source, --features, -j, --progress, -q.
+void addMatchOptions(CLI::App& sub, MatchFilesOptions& o);
+
+}  // namespace tomomap::cli

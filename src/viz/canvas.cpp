@@ -1,0 +1,136 @@
+#include "canvas.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <iomanip>
+
+#include "core/types.hpp"
+
+namespace tomomap::viz {
+
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+
+void drawText(cv::Mat& img, const std::string& text, cv::Point at, double scale, const cv::Scalar& c, Align align,
+              int thickness) {
+  int baseline = 0;
+  const cv::Size size = cv::getTextSize(text, kFont, scale, thickness, &baseline);
+  if (align == Align::Centre) at.x -= size.width / 2;
+  if (align == Align::Right) at.x -= size.width;
+  cv::putText(img, text, at, kFont, scale, c, thickness, cv::LINE_AA);
+}
+
+void drawVerticalText(cv::Mat& img, const std::string& text, cv::Point centre, double scale) {
+  int baseline = 0;
+  const cv::Size size = cv::getTextSize(text, kFont, scale, 1, &baseline);
+  cv::Mat strip(size.height + baseline + 4, size.width + 4, img.type(), colour::kWhite);
+  cv::putText(strip, text, {2, size.height + 2}, kFont, scale, colour::kBlack, 1, cv::LINE_AA);
+  cv::Mat turned;
+  cv::rotate(strip, turned, cv::ROTATE_90_COUNTERCLOCKWISE);
+  cv::Rect where(centre.x - turned.cols / 2, centre.y - turned.rows / 2, turned.cols, turned.rows);
+  where &= cv::Rect(0, 0, img.cols, img.rows);
+  turned(cv::Rect(0, 0, where.width, where.height)).copyTo(img(where));
+}
+
+void drawDashedLine(cv::Mat& img, cv::Point a, cv::Point b, const cv::Scalar& c, int thickness, int dash) {
+  const double length = std::hypot(b.x - a.x, b.y - a.y);
+  for (double s = 0; s < length; s += 2 * dash) {
+    const double e = std::min(length, s + dash);
+    const cv::Point p(a.x + static_cast<int>((b.x - a.x) * s / length), a.y + static_cast<int>((b.y - a.y) * s / length));
+    const cv::Point q(a.x + static_cast<int>((b.x - a.x) * e / length), a.y + static_cast<int>((b.y - a.y) * e / length));
+    cv::line(img, p, q, c, thickness, cv::LINE_AA);
+  }
+}
+
+ValueAxis ValueAxis::fit(std::vector<double> values, bool log, int top, int bottom, double also) {
+  if (std::isfinite(also)) values.push_back(also);
+  values.erase(std::remove_if(values.begin(), values.end(),
+                              [log](double v) { return !std::isfinite(v) || (log && v <= 0); }),
+               values.end());
+  ValueAxis a;
+  a.log = log;
+  a.top = top;
+  a.bottom = bottom;
+  if (values.empty()) {
+    a.lo = log ? 0.1 : 0;
+    a.hi = log ? 10 : 1;
+    return a;
+  }
+  const auto [mn, mx] = std::minmax_element(values.begin(), values.end());
+  if (log) {
+    a.lo = std::pow(10.0, std::floor(std::log10(*mn)));
+    a.hi = std::pow(10.0, std::ceil(std::log10(*mx)));
+    if (a.hi <= a.lo) a.hi = a.lo * 10;
+  } else {
+    a.lo = std::min(0.0, *mn);
+    a.hi = *mx > a.lo ? *mx * 1.1 : a.lo + 1;
+  }
+  return a;
+}
+
+int ValueAxis::row(double v) const {
+  double f;
+  if (log)
+    f = (std::log10(std::max(v, lo)) - std::log10(lo)) / (std::log10(hi) - std::log10(lo));
+  else
+    f = (v - lo) / (hi - lo);
+  f = std::clamp(f, 0.0, 1.0);
+  return bottom - static_cast<int>(std::lround(f * (bottom - top)));
+}
+
+std::vector<double> ValueAxis::ticks() const {
+  std::vector<double> t;
+  if (log) {
+    for (double v = lo; v <= hi * 1.0001; v *= 10) t.push_back(v);
+    return t;
+  }
+  const double raw = (hi - lo) / 6;
+  const double decade = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = decade;
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (m * decade >= raw) {
+      step = m * decade;
+      break;
+    }
+  for (double v = std::ceil(lo / step) * step; v <= hi + 1e-9; v += step) t.push_back(v);
+  return t;
+}
+
+std::string tickLabel(double v) {
+  std::ostringstream o;
+  if (std::abs(v) < 1e-9) v = 0;  // no "-0"
+  if (v != 0 && (std::abs(v) >= 1e4 || std::abs(v) < 1e-3))
+    o << std::scientific << std::setprecision(0) << v;
+  else
+    o << v;
+  return o.str();
+}
+
+cv::Mat stack(const std::vector<cv::Mat>& images, bool vertical) {
+  int w = 0, h = 0;
+  for (const auto& m : images) {
+    w = vertical ? std::max(w, m.cols) : w + m.cols;
+    h = vertical ? h + m.rows : std::max(h, m.rows);
+  }
+  cv::Mat out(std::max(h, 1), std::max(w, 1), CV_8UC3, colour::kWhite);
+  int at = 0;
+  for (const auto& m : images) {
+    m.copyTo(out(vertical ? cv::Rect(0, at, m.cols, m.rows) : cv::Rect(at, 0, m.cols, m.rows)));
+    at += vertical ? m.rows : m.cols;
+  }
+  return out;
+}
+
+void writePng(const std::string& path, const cv::Mat& img) {
+  bool ok = false;
+  try {
+    ok = cv::imwrite(path, img);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok) throw InputError(path + ": cannot write the picture (does the folder exist and is it writable?)");
+}
+
+}  // namespace tomomap::viz

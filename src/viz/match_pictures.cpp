@@ -1,0 +1,196 @@
+#include "match_pictures.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <iomanip>
+#include <sstream>
+
+namespace tomomap::viz {
+namespace {
+
+/// Map-frame x, y of the cells occupied in at least `min_slices` slices: walls,
+/// columns and furniture seen from above. Floors and ceilings fill one or two
+/// slices each and would paint the whole footprint.
+std::vector<Eigen::Vector2d> verticalStructure(const SliceStack& s, int min_slices = 3) {
+  std::vector<uint32_t> cells;
+  for (const auto& slice : s.cells) cells.insert(cells.end(), slice.begin(), slice.end());
+  std::sort(cells.begin(), cells.end());
+  std::vector<Eigen::Vector2d> xy;
+  const auto w = static_cast<uint32_t>(s.grid.width);
+  for (size_t i = 0; i < cells.size();) {
+    size_t j = i;
+    while (j < cells.size() && cells[j] == cells[i]) ++j;
+    if (static_cast<int>(j - i) >= min_slices)
+      xy.push_back(s.grid.toMetres(static_cast<float>(cells[i] % w), static_cast<float>(cells[i] / w)).cast<double>());
+    i = j;
+  }
+  return xy;
+}
+
+std::string metres(double v, int digits = 2) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(digits) << v;
+  return o.str();
+}
+
+/// A slice as dark cells on white, BGR.
+cv::Mat sliceImage(const SliceStack& s, int k, int pad) {
+  cv::Mat grey = 255 - s.image(k, pad), bgr;
+  cv::cvtColor(grey, bgr, cv::COLOR_GRAY2BGR);
+  return bgr;
+}
+
+const SliceFeatures* findSlice(const MapFeatures& f, int index) {
+  for (const auto& s : f.slices)
+    if (s.index == index) return &s;
+  return nullptr;
+}
+
+}  // namespace
+
+cv::Mat drawOverlay(const SliceStack& target, const SliceStack& source, const Pose4& T,
+                    const std::vector<std::string>& caption) {
+  std::vector<Eigen::Vector2d> t_xy = verticalStructure(target);
+  std::vector<Eigen::Vector2d> s_xy = verticalStructure(source);
+  const double c = std::cos(T.yaw), s = std::sin(T.yaw);
+  for (auto& p : s_xy) p = Eigen::Vector2d(c * p.x() - s * p.y() + T.x, s * p.x() + c * p.y() + T.y);
+
+  Eigen::Vector2d lo(INFINITY, INFINITY), hi(-INFINITY, -INFINITY);
+  for (const auto* set : {&t_xy, &s_xy})
+    for (const auto& p : *set) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  if (t_xy.empty() && s_xy.empty()) lo = hi = Eigen::Vector2d::Zero();
+  const double extent = std::max({hi.x() - lo.x(), hi.y() - lo.y(), 1.0});
+  // About 1000 pixels across; a cell is drawn as a square of at least one pixel.
+  const double px = extent / 1000.0;  // metres per pixel
+  const int cell_px = std::max(1, static_cast<int>(std::lround(target.grid.cell / px)));
+  const int w = static_cast<int>((hi.x() - lo.x()) / px) + cell_px, h = static_cast<int>((hi.y() - lo.y()) / px) + cell_px;
+
+  cv::Mat t_mask = cv::Mat::zeros(h, w, CV_8U), s_mask = cv::Mat::zeros(h, w, CV_8U);
+  auto plot = [&](const std::vector<Eigen::Vector2d>& xy, cv::Mat& mask) {
+    for (const auto& p : xy) {
+      const int u = static_cast<int>((p.x() - lo.x()) / px), v = h - cell_px - static_cast<int>((p.y() - lo.y()) / px);
+      cv::rectangle(mask, cv::Rect(u, v, cell_px, cell_px), 255, cv::FILLED);
+    }
+  };
+  plot(t_xy, t_mask);
+  plot(s_xy, s_mask);
+
+  const int margin_l = 80, margin_t = 64 + 24 * static_cast<int>(caption.size()), margin_b = 60;
+  const int margin_r = std::max(30, 1100 - margin_l - w);  // room for the caption
+  cv::Mat img(h + margin_t + margin_b, w + margin_l + margin_r, CV_8UC3, colour::kWhite);
+  cv::Mat plot_area = img(cv::Rect(margin_l, margin_t, w, h));
+  const cv::Vec3b blue(178, 114, 0), orange(0, 140, 230), both(60, 40, 40);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const bool a = t_mask.at<uint8_t>(v, u), b = s_mask.at<uint8_t>(v, u);
+      if (a || b) plot_area.at<cv::Vec3b>(v, u) = a && b ? both : a ? blue : orange;
+    }
+  cv::rectangle(img, cv::Rect(margin_l - 1, margin_t - 1, w + 2, h + 2), colour::kGrey, 1);
+
+  for (size_t i = 0; i < caption.size(); ++i)
+    drawText(img, caption[i], {margin_l, 26 + 24 * static_cast<int>(i)}, 0.55, colour::kBlack, Align::Left,
+             i == 0 ? 2 : 1);
+  // Metre ticks on both axes.
+  const ValueAxis xa{lo.x(), lo.x() + w * px, false, 0, 0}, ya{lo.y(), lo.y() + h * px, false, 0, 0};
+  for (double x : xa.ticks()) {
+    const int u = margin_l + static_cast<int>((x - lo.x()) / px);
+    cv::line(img, {u, margin_t + h}, {u, margin_t + h + 6}, colour::kBlack);
+    drawText(img, tickLabel(std::round(x * 100) / 100), {u, margin_t + h + 22}, 0.42, colour::kBlack, Align::Centre);
+  }
+  for (double y : ya.ticks()) {
+    const int v = margin_t + h - 1 - static_cast<int>((y - lo.y()) / px);
+    cv::line(img, {margin_l - 6, v}, {margin_l, v}, colour::kBlack);
+    drawText(img, tickLabel(std::round(y * 100) / 100), {margin_l - 9, v + 5}, 0.42, colour::kBlack, Align::Right);
+  }
+  drawText(img, "x [m]", {margin_l + w / 2, margin_t + h + 44}, 0.5, colour::kBlack, Align::Centre);
+  drawVerticalText(img, "y [m]", {18, margin_t + h / 2}, 0.5);
+  // Legend, under the caption.
+  int lx = margin_l;
+  const int ly = margin_t - 18;
+  for (const auto& [name, col] : {std::pair<std::string, cv::Vec3b>{"target", blue}, {"source (aligned)", orange},
+                                  {"both", both}}) {
+    cv::rectangle(img, cv::Rect(lx, ly - 11, 14, 12), cv::Scalar(col[0], col[1], col[2]), cv::FILLED);
+    drawText(img, name, {lx + 20, ly}, 0.45);
+    lx += 40 + 9 * static_cast<int>(name.size());
+  }
+  return img;
+}
+
+cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchResult& r, int count,
+                       double inlier_cells) {
+  std::vector<cv::Mat> rows;
+  const SliceGrid& tg = target.occupancy.grid;
+  const SliceGrid& sg = source.occupancy.grid;
+  const Rigid2D T{r.T_target_source.yaw, {r.T_target_source.x, r.T_target_source.y}};
+  const int pad = 8;
+  for (const auto& pair : r.supporters) {
+    if (static_cast<int>(rows.size()) >= count) break;
+    const SliceFeatures* ft = findSlice(target, pair.target_slice);
+    const SliceFeatures* fs = findSlice(source, pair.source_slice);
+    if (!ft || !fs || pair.target_slice >= target.occupancy.size() || pair.source_slice >= source.occupancy.size())
+      continue;
+    const Correspondences c = matchSlices(*ft, *fs);
+    const auto inliers = collectInliers(c, T, inlier_cells * target.grid);
+
+    cv::Mat left = sliceImage(target.occupancy, pair.target_slice, pad);
+    cv::Mat right = sliceImage(source.occupancy, pair.source_slice, pad);
+    // Same height on both sides, white below (drawMatches would fill black).
+    const int rows_needed = std::max(left.rows, right.rows);
+    cv::copyMakeBorder(left, left, 0, rows_needed - left.rows, 0, 0, cv::BORDER_CONSTANT, colour::kWhite);
+    cv::copyMakeBorder(right, right, 0, rows_needed - right.rows, 0, 0, cv::BORDER_CONSTANT, colour::kWhite);
+    // Enlarge small slices (whole pixels, no smoothing), shrink huge ones.
+    const double scale = std::clamp(700.0 / std::max({left.cols, left.rows, right.cols, right.rows}), 0.25, 8.0);
+    const double f = scale >= 1 ? std::floor(scale) : scale;
+    cv::resize(left, left, {}, f, f, f >= 1 ? cv::INTER_NEAREST : cv::INTER_AREA);
+    cv::resize(right, right, {}, f, f, f >= 1 ? cv::INTER_NEAREST : cv::INTER_AREA);
+    auto toPixel = [&](const SliceGrid& g, const Eigen::Vector2d& p) {
+      return cv::Point2f(static_cast<float>(((p.x() - g.x_min) / g.cell - 0.5 + pad + 0.5) * f),
+                         static_cast<float>(((p.y() - g.y_min) / g.cell - 0.5 + pad + 0.5) * f));
+    };
+    std::vector<cv::KeyPoint> kt, ks;
+    std::vector<cv::DMatch> matches;
+    std::vector<char> mask(c.size(), 0);
+    for (uint32_t i : inliers) mask[i] = 1;
+    for (size_t i = 0; i < c.size(); ++i) {
+      kt.emplace_back(toPixel(tg, c.target[i]), 1.f);
+      ks.emplace_back(toPixel(sg, c.source[i]), 1.f);
+      matches.emplace_back(static_cast<int>(i), static_cast<int>(i), 0.f);
+    }
+    cv::Mat drawn;
+    cv::drawMatches(left, kt, right, ks, matches, drawn, cv::Scalar(40, 170, 40), colour::kGrey, mask);
+    cv::line(drawn, {left.cols, 0}, {left.cols, drawn.rows}, colour::kGrey, 2);
+
+    cv::Mat header(56, std::max(drawn.cols, 1000), CV_8UC3, colour::kWhite);
+    drawText(header,
+             "target slice " + std::to_string(pair.target_slice) + " (z " +
+                 metres(tg.sliceHeight(pair.target_slice)) + " m)  |  source slice " +
+                 std::to_string(pair.source_slice) + " (z " + metres(sg.sliceHeight(pair.source_slice)) + " m)",
+             {8, 22}, 0.55, colour::kBlack, Align::Left, 2);
+    drawText(header,
+             std::to_string(c.size()) + " mutual descriptor matches, " + std::to_string(inliers.size()) +
+                 " agree with the result (green, within " + metres(inlier_cells, 0) + " cells); grey: the rest",
+             {8, 46}, 0.48);
+    rows.push_back(header);
+    rows.push_back(drawn);
+    rows.push_back(cv::Mat(16, drawn.cols, CV_8UC3, colour::kWhite));
+  }
+  if (rows.empty()) {
+    cv::Mat none(80, 700, CV_8UC3, colour::kWhite);
+    drawText(none, "no supporting slice pair to show", {10, 45}, 0.6, colour::kRed);
+    return none;
+  }
+  cv::Mat out = stack(rows);
+  cv::Mat head(40, std::max(out.cols, 1000), CV_8UC3, colour::kWhite);
+  drawText(head,
+           "winning height offset " + std::to_string(r.height_offset) + " slices (" +
+               metres(r.T_target_source.z) + " m), " + std::to_string(r.support) + " agreeing slice pairs",
+           {8, 28}, 0.65, colour::kBlack, Align::Left, 2);
+  return stack({head, out});
+}
+
+}  // namespace tomomap::viz
