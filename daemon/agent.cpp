@@ -1,0 +1,478 @@
+#include "agent.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <iomanip>
+#include <sstream>
+
+#include "core/map_io.hpp"
+#include "core/matcher.hpp"
+#include "core/voxel_filter.hpp"
+#include "state_files.hpp"
+
+namespace tomomap::daemon {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr auto kTick = std::chrono::milliseconds(50);
+constexpr auto kClaimSettle = std::chrono::milliseconds(500);  ///< time for competing claims to show up
+constexpr auto kReannounce = std::chrono::seconds(5);
+constexpr auto kStatusEvery = std::chrono::seconds(1);
+constexpr size_t kPcdHeaderBytes = 190;  ///< a binary PCD header for x y z float
+
+double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+uint64_t wallMs() {
+  return static_cast<uint64_t>(
+      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count());
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(digits) << v;
+  return o.str();
+}
+
+
+std::string pairText(const PairKey& p) { return p.first + "<-" + p.second; }
+
+}  // namespace
+
+Agent::Agent(Config config, Log& log) : config_(std::move(config)), log_(log) {}
+
+Agent::~Agent() {
+  if (worker_.joinable()) worker_.join();
+}
+
+void Agent::post(std::function<void()> work) {
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    queue_.push_back(std::move(work));
+  }
+  queue_cv_.notify_one();
+}
+
+void Agent::describeOwnMap() {
+  const auto t0 = Clock::now();
+  Points map = loadMap(config_.map);
+  validateMap(map, config_.map);
+  const Points filtered = voxelFilter(map, config_.grid);
+  Points().swap(map);
+  const uint64_t raw_bytes = 12 * filtered.size() + kPcdHeaderBytes;
+  auto features = std::make_shared<MapFeatures>(extractFeatures(makeSlices(filtered, config_.grid)));
+  const double extract_s = seconds(Clock::now() - t0);
+  offer_ = transport::makeOffer(config_.agent(), *features, raw_bytes,
+                                transport::maxSampleBytes(config_.transport.bandwidth_kbps));
+  own_features_ = std::move(features);
+  log_.info("map " + config_.map + ": " + std::to_string(filtered.size()) + " cells at g " + fixed(config_.grid, 3) +
+            " m, " + std::to_string(offer_.announcement.slices().size()) + " descriptive slices, " +
+            std::to_string(own_features_->featureCount()) + " features; version " +
+            versionText(offer_.announcement.version()) + "; payload " + std::to_string(offer_.payload_bytes) +
+            " bytes = " + fixed(100.0 * static_cast<double>(offer_.payload_bytes) / static_cast<double>(raw_bytes), 1) +
+            " % of the voxel-filtered map's binary PCD (" + std::to_string(raw_bytes) + " bytes); described in " +
+            fixed(extract_s, 2) + " s");
+}
+
+bool Agent::known(const std::string& agent, const char* what) {
+  if (agent == config_.agent() || config_.isPeer(agent)) return true;
+  ++counters_.unknown_agent;
+  log_.debug(std::string("dropped ") + what + " from unknown agent '" + agent + "'");
+  return false;
+}
+
+void Agent::reject(const std::string& from, const std::string& why) {
+  ++counters_.rejected;
+  log_.warning("rejected a sample from " + from + ": " + why);
+}
+
+std::optional<uint64_t> Agent::versionOf(const std::string& agent) const {
+  if (agent == config_.agent()) return offer_.announcement.version();
+  const auto it = peers_.find(agent);
+  if (it == peers_.end() || !it->second.incoming) return std::nullopt;
+  return it->second.incoming->announcement().version();
+}
+
+std::shared_ptr<const MapFeatures> Agent::featuresOf(const std::string& agent) const {
+  if (agent == config_.agent()) return own_features_;
+  const auto it = peers_.find(agent);
+  return it == peers_.end() ? nullptr : it->second.features;
+}
+
+void Agent::onAnnouncement(wire::MapAnnouncement&& a) {
+  if (a.agent().to_string() == config_.agent() || !known(a.agent().to_string(), "an announcement")) return;
+  if (const auto why = transport::validate(a); !why.empty()) return reject(a.agent().to_string(), why);
+  PeerMap& p = peers_[a.agent().to_string()];
+  if (p.incoming && p.incoming->announcement().version() == a.version()) return;  // already known
+  log_.info("peer " + a.agent().to_string() + " announced map version " + versionText(a.version()) + ": " +
+            std::to_string(a.slices().size()) + " slices");
+  p = PeerMap{};
+  p.incoming.emplace(std::move(a));
+  p.last_progress = Clock::now();
+  wire::ChunkRequest r;  // first contact: everything (an empty list)
+  r.requester(config_.agent());
+  r.owner(p.incoming->announcement().agent().to_string());
+  r.version(p.incoming->announcement().version());
+  bus_->publish(r);
+  p.last_request = Clock::now();
+}
+
+void Agent::onSlice(wire::SliceFeatures&& s, size_t bytes) {
+  if (s.agent().to_string() == config_.agent() || !known(s.agent().to_string(), "a slice")) return;
+  const auto it = peers_.find(s.agent().to_string());
+  if (it == peers_.end() || !it->second.incoming || it->second.incoming->announcement().version() != s.version())
+    return;  // a version we were not told about (yet) or no longer want
+  PeerMap& p = it->second;
+  if (p.features) return;  // complete already: a resend meant for another peer
+  if (const auto why = p.incoming->accept(s); !why.empty()) return reject(s.agent().to_string(), why);
+  const auto now = Clock::now();
+  if (p.samples++ == 0) {
+    p.first_slice = now;
+    p.first_slice_bytes = bytes;
+  }
+  p.bytes += bytes;
+  p.last_slice = p.last_progress = now;
+  if (!p.incoming->complete()) return;
+  p.features = std::make_shared<MapFeatures>(p.incoming->build({}));
+  const double span = seconds(p.last_slice - p.first_slice);
+  const double rate = span > 0 ? static_cast<double>(p.bytes - p.first_slice_bytes) * 8 / 1000 / span : 0;
+  log_.info("received the map of " + s.agent().to_string() + ": " + std::to_string(p.incoming->sliceCount()) + " slices, " +
+            std::to_string(p.bytes) + " bytes in " + std::to_string(p.samples) + " samples over " + fixed(span, 2) +
+            " s (" + fixed(rate, 0) + " kbit/s)");
+}
+
+void Agent::onRequest(wire::ChunkRequest&& r) {
+  if (r.requester().to_string() == config_.agent() || r.owner().to_string() != config_.agent()) return;
+  if (!known(r.requester().to_string(), "a request")) return;
+  if (r.version() != offer_.announcement.version()) return;  // an old version: the announcement tells them
+  std::vector<int> wanted;
+  if (r.slices().empty())
+    for (const auto& e : offer_.announcement.slices()) wanted.push_back(e.slice());
+  else
+    for (int32_t k : r.slices())
+      if (offer_.samples.count(k)) wanted.push_back(k);
+  for (int k : wanted)
+    if (queued_.insert(k).second) send_queue_.push_back(k);
+  log_.debug(r.requester().to_string() + " asked for " + std::to_string(wanted.size()) + " slices; " +
+             std::to_string(send_queue_.size()) + " queued");
+}
+
+void Agent::onClaim(wire::MatchClaim&& c) {
+  if (c.claimer().to_string() == config_.agent() || !known(c.claimer().to_string(), "a claim")) return;
+  const PairKey key{c.target().to_string(), c.source().to_string()};
+  Claim& held = claims_[key];
+  // Keep the claim that wins: lowest claimer id among current ones.
+  const bool replace = held.claimer.empty() || c.claimer().to_string() <= held.claimer ||
+                       seconds(Clock::now() - held.seen) > config_.claim_timeout_s;
+  if (replace) held = {c.claimer().to_string(), c.target_version(), c.source_version(), Clock::now()};
+  log_.debug(c.claimer().to_string() + " claims " + pairText(key));
+}
+
+void Agent::onEstimate(wire::TransformEstimate&& e) {
+  if (e.computed_by().to_string() == config_.agent()) return;  // our own, stored already
+  if (!known(e.target().to_string(), "an estimate") || !known(e.source().to_string(), "an estimate") ||
+      !known(e.computed_by().to_string(), "an estimate"))
+    return;
+  if (e.target().to_string() >= e.source().to_string()) return reject(e.computed_by().to_string(), "estimate with an unordered pair");
+  for (double v : {e.x(), e.y(), e.z(), e.yaw()})
+    if (!std::isfinite(v)) return reject(e.computed_by().to_string(), "estimate with a non-finite transform");
+  const PairKey key{e.target().to_string(), e.source().to_string()};
+  const auto vt = versionOf(e.target().to_string()), vs = versionOf(e.source().to_string());
+  const bool current = (!vt || *vt == e.target_version()) && (!vs || *vs == e.source_version());
+  const auto it = results_.find(key);
+  if (!current && it != results_.end()) return;  // we hold a result for newer maps
+  if (it != results_.end() && it->second.target_version() == e.target_version() &&
+      it->second.source_version() == e.source_version() && it->second.computed_by().to_string() <= e.computed_by().to_string())
+    return;  // the same result again (or a duplicate computation: keep one, deterministically)
+  log_.info("agreed " + pairText(key) + " from " + e.computed_by().to_string() + ": x " + fixed(e.x(), 3) + " y " +
+            fixed(e.y(), 3) + " z " + fixed(e.z(), 3) + " yaw " + fixed(e.yaw(), 4) +
+            (e.reliable() ? "" : " (no reliable match: " + e.reason().to_string() + ")"));
+  results_[key] = std::move(e);
+  claims_.erase(key);
+  own_claims_.erase(key);
+  persist(true);
+}
+
+void Agent::onPeer(const std::string& name, bool alive) {
+  const std::string prefix = "tomomapd/";
+  if (name.rfind(prefix, 0) != 0) return;
+  const std::string id = name.substr(prefix.size());
+  if (!config_.isPeer(id)) {
+    log_.debug("participant '" + name + "' is not in the config; its samples will be dropped");
+    return;
+  }
+  if (alive) {
+    if (alive_.insert(id).second) log_.info("peer " + id + " is up");
+    // A late joiner gets what this agent computed, in case durability missed it.
+    for (const auto& [key, e] : results_)
+      if (e.computed_by().to_string() == config_.agent()) bus_->publish(e);
+  } else if (alive_.erase(id)) {
+    log_.warning("peer " + id + " is gone");
+    for (auto it = claims_.begin(); it != claims_.end();)
+      it = it->second.claimer == id ? claims_.erase(it) : std::next(it);
+  }
+}
+
+void Agent::pumpSends() {
+  while (!send_queue_.empty()) {
+    const int k = send_queue_.front();
+    const auto& samples = offer_.samples.at(k);
+    if (!bus_->publish(samples[next_part_])) return;  // the writer's queue is full: next tick
+    counters_.bytes_sent += transport::Bus::serializedSize(samples[next_part_]);
+    ++counters_.samples_sent;
+    if (++next_part_ == samples.size()) {
+      next_part_ = 0;
+      send_queue_.pop_front();
+      queued_.erase(k);
+    }
+  }
+}
+
+void Agent::requestMissing() {
+  const auto now = Clock::now();
+  for (auto& [id, p] : peers_) {
+    if (!p.incoming || p.features) continue;
+    const auto quiet_since = std::max(p.last_progress, p.last_request);
+    if (seconds(now - quiet_since) < config_.request_interval_s) continue;
+    wire::ChunkRequest r;
+    r.requester(config_.agent());
+    r.owner(id);
+    r.version(p.incoming->announcement().version());
+    r.slices(p.incoming->missing());
+    bus_->publish(r);
+    p.last_request = now;
+    log_.info("asked " + id + " again for " + std::to_string(r.slices().size()) + " missing slices");
+  }
+}
+
+void Agent::claimAndCompute() {
+  if (computing_) return;
+  std::vector<std::string> holders{config_.agent()};
+  for (const auto& [id, p] : peers_)
+    if (p.features) holders.push_back(id);
+  std::sort(holders.begin(), holders.end());
+  const auto now = Clock::now();
+  for (size_t i = 0; i < holders.size(); ++i)
+    for (size_t j = i + 1; j < holders.size(); ++j) {
+      const PairKey key{holders[i], holders[j]};
+      const uint64_t vt = *versionOf(key.first), vs = *versionOf(key.second);
+      const auto done = results_.find(key);
+      if (done != results_.end() && done->second.target_version() == vt && done->second.source_version() == vs)
+        continue;
+      const auto other = claims_.find(key);
+      const bool live_other = other != claims_.end() && other->second.target_version == vt &&
+                              other->second.source_version == vs &&
+                              seconds(now - other->second.seen) < config_.claim_timeout_s;
+      const auto mine = own_claims_.find(key);
+      if (mine == own_claims_.end()) {
+        if (live_other) continue;  // someone else is on it
+        wire::MatchClaim c;
+        c.target(key.first);
+        c.source(key.second);
+        c.target_version(vt);
+        c.source_version(vs);
+        c.claimer(config_.agent());
+        c.claimed_at_ms(wallMs());
+        bus_->publish(c);
+        own_claims_[key] = now;
+        log_.info("claimed " + pairText(key));
+        continue;
+      }
+      if (now - mine->second < kClaimSettle) continue;
+      if (live_other && other->second.claimer < config_.agent()) {  // the tie-break: lowest id computes
+        log_.info("yielding " + pairText(key) + " to " + other->second.claimer);
+        own_claims_.erase(mine);
+        continue;
+      }
+      // Compute on a worker so the loop keeps serving peers meanwhile.
+      computing_ = key;
+      worker_done_ = false;
+      auto target = featuresOf(key.first), source = featuresOf(key.second);
+      const double grid = config_.grid;
+      const std::string me = config_.agent();
+      worker_ = std::thread([this, key, target, source, grid, me, vt, vs] {
+        const auto t0 = Clock::now();
+        MatchParams params;
+        params.grid = grid;
+        wire::TransformEstimate e;
+        e.target(key.first);
+        e.source(key.second);
+        e.target_version(vt);
+        e.source_version(vs);
+        e.computed_by(me);
+        try {
+          const MatchResult r = matchFeatures(*target, *source, params);
+          e.reliable(r.reliable);
+          e.reason(r.reason.substr(0, 120));
+          const Pose4& T = r.T_target_source;
+          e.x(T.x);
+          e.y(T.y);
+          e.z(T.z);
+          e.yaw(T.yaw);
+          const Eigen::Matrix4d M = T.matrix();
+          for (int row = 0; row < 4; ++row)
+            for (int col = 0; col < 4; ++col) e.matrix()[static_cast<size_t>(4 * row + col)] = M(row, col);
+          e.support(r.support);
+          e.runner_up_support(r.runner_up_support);
+          e.inliers(static_cast<uint32_t>(r.inliers));
+          e.spread({r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z()});
+        } catch (const std::exception& ex) {
+          e.reliable(false);
+          e.reason(std::string(ex.what()).substr(0, 120));
+        }
+        e.computed_at_ms(wallMs());
+        e.seconds(seconds(Clock::now() - t0));
+        computed_ = std::move(e);
+        worker_done_ = true;
+        queue_cv_.notify_one();
+      });
+      log_.info("computing " + pairText(key));
+      return;
+    }
+}
+
+void Agent::finishCompute() {
+  if (!computing_ || !worker_done_) return;
+  worker_.join();
+  const PairKey key = *computing_;
+  computing_.reset();
+  own_claims_.erase(key);
+  ++counters_.matches_computed;
+  const auto& e = computed_;
+  log_.info("computed " + pairText(key) + " in " + fixed(e.seconds(), 2) + " s: " +
+            (e.reliable() ? "x " + fixed(e.x(), 3) + " y " + fixed(e.y(), 3) + " z " + fixed(e.z(), 3) + " yaw " +
+                                fixed(e.yaw(), 4) + ", support " + std::to_string(e.support()) + ", " +
+                                std::to_string(e.inliers()) + " inliers"
+                          : "no reliable match: " + e.reason().to_string()));
+  // Versions may have moved on while matching: then the next round recomputes.
+  results_[key] = computed_;
+  bus_->publish(computed_);
+  persist(true);
+}
+
+void Agent::persist(bool transforms_changed) {
+  const fs::path dir(config_.output_dir);
+  try {
+    if (transforms_changed) {
+      nlohmann::json list = nlohmann::json::array();
+      for (const auto& [key, e] : results_) list.push_back(toJson(e));
+      writeJsonAtomically((dir / "transforms.json").string(), {{"agent", config_.agent()}, {"transforms", list}});
+    }
+    nlohmann::json peers = nlohmann::json::object();
+    for (const auto& peer : config_.transport.peers) {
+      nlohmann::json j{{"alive", alive_.count(peer.id) > 0}};
+      const auto it = peers_.find(peer.id);
+      if (it != peers_.end() && it->second.incoming) {
+        const PeerMap& p = it->second;
+        const double span = seconds(p.last_slice - p.first_slice);
+        j["version"] = versionText(p.incoming->announcement().version());
+        j["slices_received"] = p.incoming->slicesDone();
+        j["slices_total"] = p.incoming->sliceCount();
+        j["bytes_received"] = p.bytes;
+        j["samples_received"] = p.samples;
+        j["complete"] = p.features != nullptr;
+        j["transfer_seconds"] = span;
+        j["rate_kbps"] = span > 0 ? static_cast<double>(p.bytes - p.first_slice_bytes) * 8 / 1000 / span : 0.0;
+      }
+      peers[peer.id] = j;
+    }
+    const auto& a = offer_.announcement;
+    nlohmann::json status{{"agent", config_.agent()},
+                          {"pid", ::getpid()},
+                          {"uptime_s", seconds(Clock::now() - started_)},
+                          {"map",
+                           {{"path", config_.map},
+                            {"version", versionText(a.version())},
+                            {"slices", a.slices().size()},
+                            {"payload_bytes", offer_.payload_bytes},
+                            {"raw_bytes", a.raw_bytes()}}},
+                          {"bandwidth_kbps", config_.transport.bandwidth_kbps},
+                          {"sent", {{"bytes", counters_.bytes_sent}, {"samples", counters_.samples_sent}}},
+                          {"peers", peers},
+                          {"pairs_agreed", results_.size()},
+                          {"matches_computed", counters_.matches_computed},
+                          {"dropped_unknown_agent", counters_.unknown_agent},
+                          {"rejected_samples", counters_.rejected}};
+    writeJsonAtomically((dir / "status.json").string(), status);
+  } catch (const std::exception& e) {
+    log_.error(std::string("cannot write state: ") + e.what());
+  }
+}
+
+int Agent::run(const std::atomic<bool>& stop) {
+  log_.info(describe(config_));
+  std::error_code ec;
+  fs::create_directories(config_.output_dir, ec);
+  if (ec) {
+    log_.error(config_.output_dir + ": cannot create the output directory: " + ec.message());
+    return 2;
+  }
+  try {
+    describeOwnMap();
+  } catch (const InputError& e) {
+    log_.error(e.what());
+    return 2;
+  }
+  transport::BusHandlers h;
+  h.announcement = [this](wire::MapAnnouncement&& a) {
+    post([this, a = std::move(a)]() mutable { onAnnouncement(std::move(a)); });
+  };
+  h.slice = [this](wire::SliceFeatures&& s, size_t bytes) {
+    post([this, s = std::move(s), bytes]() mutable { onSlice(std::move(s), bytes); });
+  };
+  h.request = [this](wire::ChunkRequest&& r) { post([this, r = std::move(r)]() mutable { onRequest(std::move(r)); }); };
+  h.claim = [this](wire::MatchClaim&& c) { post([this, c = std::move(c)]() mutable { onClaim(std::move(c)); }); };
+  h.estimate = [this](wire::TransformEstimate&& e) {
+    post([this, e = std::move(e)]() mutable { onEstimate(std::move(e)); });
+  };
+  h.peer = [this](const std::string& name, bool alive) { post([this, name, alive] { onPeer(name, alive); }); };
+  try {
+    bus_ = std::make_unique<transport::Bus>(config_.transport, h);
+  } catch (const std::exception& e) {
+    log_.error(e.what());
+    return 2;
+  }
+  bus_->publish(offer_.announcement);
+  persist(true);
+  log_.info("ready: announced version " + versionText(offer_.announcement.version()) + " to " +
+            std::to_string(config_.transport.peers.size()) + " peers");
+
+  auto last_announce = Clock::now();
+  while (!stop) {
+    std::deque<std::function<void()>> work;
+    {
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      queue_cv_.wait_for(lock, kTick, [this] { return !queue_.empty() || worker_done_; });
+      work.swap(queue_);
+    }
+    for (auto& w : work) w();
+    finishCompute();
+    pumpSends();
+    requestMissing();
+    claimAndCompute();
+    const auto now = Clock::now();
+    if (now - last_announce > kReannounce) {  // repairs a lost or missed announcement
+      bus_->publish(offer_.announcement);
+      last_announce = now;
+    }
+    if (now - last_status_ > kStatusEvery) {
+      persist(false);
+      last_status_ = now;
+    }
+  }
+  log_.info("stopping");
+  persist(true);
+  if (computing_ && !worker_done_) {
+    // A match in progress is abandoned: the result would be recomputed by the
+    // fleet. Leave without waiting for it; everything else is flushed.
+    worker_.detach();
+  }
+  bus_.reset();
+  log_.info("stopped");
+  return 0;
+}
+
+}  // namespace tomomap::daemon

@@ -1,0 +1,169 @@
+#include "config.hpp"
+
+#include <toml++/toml.h>
+
+#include <filesystem>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "core/types.hpp"
+
+namespace tomomap::daemon {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::vector<std::string> kKeys{"agent",          "map",        "grid",          "domain",
+                                     "address",        "discovery_port", "data_port", "bandwidth_kbps",
+                                     "output_dir",     "log_level",  "claim_timeout_s", "request_interval_s",
+                                     "peer.id",        "peer.host",  "peer.port"};
+
+struct Reader {
+  std::string file;
+
+  [[noreturn]] void fail(const toml::node& n, const std::string& key, const std::string& what) const {
+    const auto& b = n.source().begin;
+    throw InputError(file + ":" + std::to_string(b.line) + ":" + std::to_string(b.column) + ": key '" + key + "': " +
+                     what);
+  }
+  [[noreturn]] void missing(const toml::table& t, const std::string& key) const {
+    const auto& b = t.source().begin;
+    throw InputError(file + ":" + std::to_string(b.line) + ":" + std::to_string(b.column) + ": key '" + key +
+                     "' is required");
+  }
+
+  std::string text(const toml::table& t, const std::string& key, const std::optional<std::string>& fallback) const {
+    const toml::node* n = t.get(key);
+    if (!n) {
+      if (fallback) return *fallback;
+      missing(t, key);
+    }
+    if (!n->is_string()) fail(*n, key, "must be a string");
+    return n->value<std::string>().value();
+  }
+
+  double number(const toml::table& t, const std::string& key, std::optional<double> fallback, double lo,
+                double hi) const {
+    const toml::node* n = t.get(key);
+    if (!n) {
+      if (fallback) return *fallback;
+      missing(t, key);
+    }
+    const auto v = n->value<double>();
+    if (!v || !(*v >= lo && *v <= hi))
+      fail(*n, key, "must be a number from " + toString(lo) + " to " + toString(hi));
+    return *v;
+  }
+
+  static std::string toString(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+  }
+};
+
+std::string checkedId(const Reader& r, const toml::table& t, const std::string& key) {
+  const std::string id = r.text(t, key, std::nullopt);
+  if (!std::regex_match(id, std::regex("[A-Za-z0-9_-]{1,32}")))
+    r.fail(*t.get(key), key, "must be 1 to 32 letters, digits, '-' or '_'");
+  return id;
+}
+
+std::string checkedAddress(const Reader& r, const toml::table& t, const std::string& key,
+                           const std::optional<std::string>& fallback) {
+  const std::string a = r.text(t, key, fallback);
+  if (!std::regex_match(a, std::regex(R"((\d{1,3})\.(\d{1,3})\.(\d{1,3})\.(\d{1,3}))")))
+    r.fail(*t.get(key), key, "must be an IPv4 address such as 192.168.1.20");
+  return a;
+}
+
+}  // namespace
+
+bool Config::isPeer(const std::string& id) const {
+  for (const auto& p : transport.peers)
+    if (p.id == id) return true;
+  return false;
+}
+
+const std::vector<std::string>& configKeys() { return kKeys; }
+
+Config loadConfig(const std::string& path) {
+  if (!fs::exists(path)) throw InputError(path + ": no such config file");
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    const auto& b = e.source().begin;
+    throw InputError(path + ":" + std::to_string(b.line) + ":" + std::to_string(b.column) + ": " +
+                     std::string(e.description()));
+  }
+  const Reader r{path};
+  const fs::path base = fs::absolute(path).parent_path();
+  auto resolve = [&](const std::string& p) { return (base / p).lexically_normal().string(); };
+  for (const auto& [key, node] : root) {
+    const std::string k(key.str());
+    if (k != "peer" && std::find(kKeys.begin(), kKeys.end(), k) == kKeys.end())
+      r.fail(node, k, "unknown key (see docs/configuration.md)");
+  }
+
+  Config c;
+  c.file = path;
+  auto& t = c.transport;
+  t.agent = checkedId(r, root, "agent");
+  c.map = resolve(r.text(root, "map", std::nullopt));
+  c.grid = r.number(root, "grid", 0.05, 0.005, 10);
+  t.domain = static_cast<int>(r.number(root, "domain", 0, 0, 232));
+  t.address = checkedAddress(r, root, "address", "127.0.0.1");
+  t.discovery_port = static_cast<uint16_t>(r.number(root, "discovery_port", std::nullopt, 1024, 65534));
+  t.data_port = static_cast<uint16_t>(r.number(root, "data_port", t.discovery_port + 1.0, 1024, 65535));
+  if (t.data_port == t.discovery_port) r.fail(*root.get("data_port"), "data_port", "must differ from discovery_port");
+  t.bandwidth_kbps = r.number(root, "bandwidth_kbps", 10000, 64, 10'000'000);
+  c.output_dir = resolve(r.text(root, "output_dir", "/var/lib/tomomap"));
+  const std::string level = r.text(root, "log_level", "info");
+  if (level == "debug") c.log_level = LogLevel::Debug;
+  else if (level == "info") c.log_level = LogLevel::Info;
+  else if (level == "warning") c.log_level = LogLevel::Warning;
+  else if (level == "error") c.log_level = LogLevel::Error;
+  else r.fail(*root.get("log_level"), "log_level", "must be debug, info, warning or error");
+  c.claim_timeout_s = r.number(root, "claim_timeout_s", 30, 1, 3600);
+  c.request_interval_s = r.number(root, "request_interval_s", 2, 0.1, 600);
+
+  if (const toml::node* peers = root.get("peer")) {
+    const toml::array* a = peers->as_array();
+    if (!a) r.fail(*peers, "peer", "must be an array of tables ([[peer]])");
+    std::set<std::string> ids{t.agent};
+    for (const auto& e : *a) {
+      const toml::table* p = e.as_table();
+      if (!p) r.fail(e, "peer", "each [[peer]] must be a table");
+      for (const auto& [key, node] : *p) {
+        const std::string k(key.str());
+        if (k != "id" && k != "host" && k != "port") r.fail(node, "peer." + k, "unknown key (use id, host, port)");
+      }
+      transport::PeerAddress pa;
+      pa.id = checkedId(r, *p, "id");
+      if (!ids.insert(pa.id).second)
+        r.fail(*p->get("id"), "peer.id", "'" + pa.id + "' is listed twice or is this agent's own id");
+      pa.host = checkedAddress(r, *p, "host", std::nullopt);
+      pa.port = static_cast<uint16_t>(r.number(*p, "port", std::nullopt, 1024, 65534));
+      t.peers.push_back(pa);
+    }
+  }
+  return c;
+}
+
+std::string describe(const Config& c) {
+  static const char* levels[] = {"debug", "info", "warning", "error"};
+  std::ostringstream o;
+  const auto& t = c.transport;
+  o << "config " << c.file << "\n"
+    << "  agent = " << t.agent << "\n  map = " << c.map << "\n  grid = " << c.grid << "\n  domain = " << t.domain
+    << "\n  address = " << t.address << "\n  discovery_port = " << t.discovery_port << "\n  data_port = " << t.data_port
+    << "\n  bandwidth_kbps = " << t.bandwidth_kbps << "\n  output_dir = " << c.output_dir
+    << "\n  log_level = " << levels[static_cast<int>(c.log_level)] << "\n  claim_timeout_s = " << c.claim_timeout_s
+    << "\n  request_interval_s = " << c.request_interval_s;
+  for (const auto& p : t.peers) o << "\n  peer " << p.id << " = " << p.host << ":" << p.port;
+  return o.str();
+}
+
+}  // namespace tomomap::daemon

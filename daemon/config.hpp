@@ -1,0 +1,36 @@
+#pragma once
+// tomomapd's configuration file (TOML). docs/configuration.md lists every key.
+#include <string>
+#include <vector>
+
+#include "transport/participant.hpp"
+
+namespace tomomap::daemon {
+
+enum class LogLevel { Debug, Info, Warning, Error };
+
+struct Config {
+  std::string file;                  ///< where it was read from
+  transport::TransportConfig transport;  ///< agent id, domain, address, ports, peers, bandwidth
+  std::string map;                   ///< own map file (absolute, or relative to the config file)
+  double grid = 0.05;                ///< [m]
+  std::string output_dir;            ///< transforms.json, status.json, cache/
+  LogLevel log_level = LogLevel::Info;
+  double claim_timeout_s = 30;       ///< a claim without a result is void after this [s]
+  double request_interval_s = 2;     ///< ask again for missing slices after this much silence [s]
+
+  const std::string& agent() const { return transport.agent; }
+  bool isPeer(const std::string& id) const;
+};
+
+/// Every key the parser knows, for the reference-docs test.
+const std::vector<std::string>& configKeys();
+
+/// Reads and checks a config. Throws InputError "FILE:LINE:COL: key 'k': problem"
+/// (or "FILE: problem" for a missing file or key).
+Config loadConfig(const std::string& path);
+
+/// The effective configuration, one "key = value" per line, as logged at start.
+std::string describe(const Config& c);
+
+}  // namespace tomomap::daemon

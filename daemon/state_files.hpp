@@ -1,0 +1,20 @@
+#pragma once
+// What the daemon leaves on disk for users and for `tomomap status`:
+// transforms.json (the agreed transforms) and status.json (progress), each
+// replaced atomically (write a temporary file, then rename) so a reader never
+// sees half a file, even if the daemon is killed mid-write.
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "tomomap.h"
+
+namespace tomomap::daemon {
+
+void writeJsonAtomically(const std::string& path, const nlohmann::json& j);
+
+nlohmann::json toJson(const wire::TransformEstimate& e);
+
+/// Hex form of a map version, as logged and stored.
+std::string versionText(uint64_t version);
+
+}  // namespace tomomap::daemon

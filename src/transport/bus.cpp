@@ -1,0 +1,177 @@
+#include "bus.hpp"
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <stdexcept>
+
+#include "tomomapPubSubTypes.h"
+
+namespace tomomap::transport {
+
+using namespace eprosima::fastdds::dds;
+
+namespace {
+
+/// Takes every sample as it arrives and hands it on.
+template <typename T>
+class Listener : public DataReaderListener {
+ public:
+  explicit Listener(std::function<void(T&&, size_t)> on) : on_(std::move(on)) {}
+  void on_data_available(DataReader* reader) override {
+    T sample;
+    SampleInfo info;
+    while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data && on_) on_(std::move(sample), 0);
+  }
+
+ private:
+  std::function<void(T&&, size_t)> on_;
+};
+
+class ParticipantWatch : public DomainParticipantListener {
+ public:
+  explicit ParticipantWatch(std::function<void(const std::string&, bool)> on) : on_(std::move(on)) {}
+  void on_participant_discovery(DomainParticipant*, eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    using S = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+    if (!on_) return;
+    const std::string name = info.info.m_participantName.to_string();
+    if (info.status == S::DISCOVERED_PARTICIPANT) on_(name, true);
+    if (info.status == S::REMOVED_PARTICIPANT || info.status == S::DROPPED_PARTICIPANT) on_(name, false);
+  }
+
+ private:
+  std::function<void(const std::string&, bool)> on_;
+};
+
+/// QoS shared by the small control topics.
+struct TopicQos {
+  bool transient_local = false;
+  bool keep_all = false;
+  int depth = 1;
+  int max_samples = 1024;
+  int max_instances = 1024;
+};
+
+DataWriterQos writerQos(const TopicQos& t) {
+  DataWriterQos q = DATAWRITER_QOS_DEFAULT;
+  q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  q.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(0, 200000000);
+  q.durability().kind = t.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
+  q.history().kind = t.keep_all ? KEEP_ALL_HISTORY_QOS : KEEP_LAST_HISTORY_QOS;
+  q.history().depth = t.depth;
+  q.resource_limits().max_instances = t.max_instances;
+  q.resource_limits().max_samples_per_instance = t.keep_all ? t.max_samples : t.depth;
+  q.resource_limits().max_samples = t.keep_all ? t.max_samples : t.max_instances * t.depth;
+  // Samples are allocated at their real size, not at the IDL bound.
+  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+  return q;
+}
+
+DataReaderQos readerQos(const TopicQos& t) {
+  DataReaderQos q = DATAREADER_QOS_DEFAULT;
+  q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = t.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
+  q.history().kind = t.keep_all ? KEEP_ALL_HISTORY_QOS : KEEP_LAST_HISTORY_QOS;
+  q.history().depth = t.depth;
+  q.resource_limits().max_instances = t.max_instances;
+  q.resource_limits().max_samples_per_instance = t.keep_all ? t.max_samples : t.depth;
+  q.resource_limits().max_samples = t.keep_all ? t.max_samples : t.max_instances * t.depth;
+  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+  return q;
+}
+
+}  // namespace
+
+struct Bus::Impl {
+  DomainParticipant* participant = nullptr;
+  Publisher* publisher = nullptr;
+  Subscriber* subscriber = nullptr;
+  std::unique_ptr<ParticipantWatch> watch;
+  std::vector<std::unique_ptr<DataReaderListener>> listeners;
+  DataWriter *announcements = nullptr, *slices = nullptr, *requests = nullptr, *claims = nullptr,
+             *estimates = nullptr;
+
+  template <typename PubSub, typename T>
+  DataWriter* addTopic(const std::string& name, const TopicQos& tq, std::function<void(T&&, size_t)> on,
+                       bool flow_controlled = false) {
+    TypeSupport type(new PubSub());
+    if (type.register_type(participant) != ReturnCode_t::RETCODE_OK)
+      throw std::runtime_error("cannot register type for " + name);
+    Topic* topic = participant->create_topic(name, type.get_type_name(), TOPIC_QOS_DEFAULT);
+    if (!topic) throw std::runtime_error("cannot create topic " + name);
+    DataWriterQos wq = writerQos(tq);
+    if (flow_controlled) {
+      wq.publish_mode().kind = ASYNCHRONOUS_PUBLISH_MODE;
+      wq.publish_mode().flow_controller_name = kFlowControllerName;
+    }
+    DataWriter* w = publisher->create_datawriter(topic, wq);
+    if (!w) throw std::runtime_error("cannot create the writer of " + name);
+    listeners.push_back(std::make_unique<Listener<T>>(std::move(on)));
+    if (!subscriber->create_datareader(topic, readerQos(tq), listeners.back().get()))
+      throw std::runtime_error("cannot create the reader of " + name);
+    return w;
+  }
+};
+
+Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<Impl>()) {
+  auto& i = *impl_;
+  i.participant = createParticipant(config);
+  try {
+    i.watch = std::make_unique<ParticipantWatch>(h.peer);
+    i.participant->set_listener(i.watch.get(), StatusMask::none());
+    i.publisher = i.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
+    i.subscriber = i.participant->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+    if (!i.publisher || !i.subscriber) throw std::runtime_error("cannot create publisher/subscriber");
+    auto drop_size = [](auto f) {
+      return [f](auto&& x, size_t) {
+        if (f) f(std::move(x));
+      };
+    };
+    // Announcements and estimates: one per agent / pair, kept for late joiners.
+    i.announcements = i.addTopic<wire::MapAnnouncementPubSubType, wire::MapAnnouncement>(
+        "tomomap/announcements", {true, false, 1, 0, 256}, drop_size(h.announcement));
+    i.slices = i.addTopic<wire::SliceFeaturesPubSubType, wire::SliceFeatures>(
+        "tomomap/slices", {false, true, 1, 256, 1},
+        [on = h.slice](wire::SliceFeatures&& s, size_t) {
+          const size_t bytes = serializedSize(s);
+          if (on) on(std::move(s), bytes);
+        },
+        /*flow_controlled=*/true);
+    i.requests = i.addTopic<wire::ChunkRequestPubSubType, wire::ChunkRequest>(
+        "tomomap/requests", {false, true, 1, 256, 1}, drop_size(h.request));
+    i.claims = i.addTopic<wire::MatchClaimPubSubType, wire::MatchClaim>("tomomap/claims", {false, false, 1, 0, 1024},
+                                                                       drop_size(h.claim));
+    i.estimates = i.addTopic<wire::TransformEstimatePubSubType, wire::TransformEstimate>(
+        "tomomap/estimates", {true, false, 1, 0, 1024}, drop_size(h.estimate));
+  } catch (...) {
+    i.participant->delete_contained_entities();
+    DomainParticipantFactory::get_instance()->delete_participant(i.participant);
+    throw;
+  }
+}
+
+Bus::~Bus() {
+  auto& i = *impl_;
+  i.participant->set_listener(nullptr);
+  i.participant->delete_contained_entities();
+  DomainParticipantFactory::get_instance()->delete_participant(i.participant);
+}
+
+bool Bus::publish(const wire::MapAnnouncement& a) { return impl_->announcements->write(const_cast<wire::MapAnnouncement*>(&a)); }
+bool Bus::publish(const wire::SliceFeatures& s) { return impl_->slices->write(const_cast<wire::SliceFeatures*>(&s)); }
+bool Bus::publish(const wire::ChunkRequest& r) { return impl_->requests->write(const_cast<wire::ChunkRequest*>(&r)); }
+bool Bus::publish(const wire::MatchClaim& c) { return impl_->claims->write(const_cast<wire::MatchClaim*>(&c)); }
+bool Bus::publish(const wire::TransformEstimate& e) {
+  return impl_->estimates->write(const_cast<wire::TransformEstimate*>(&e));
+}
+
+size_t Bus::serializedSize(const wire::SliceFeatures& s) { return wire::SliceFeatures::getCdrSerializedSize(s) + 4; }
+
+}  // namespace tomomap::transport

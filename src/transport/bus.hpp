@@ -1,0 +1,49 @@
+#pragma once
+// The five tomomap topics on one participant: typed publish calls, and one
+// callback per topic for what arrives (called on Fast DDS's listener thread;
+// the daemon only queues the sample there).
+#include <functional>
+#include <memory>
+
+#include "participant.hpp"
+#include "tomomap.h"
+
+namespace tomomap::transport {
+
+struct BusHandlers {
+  std::function<void(wire::MapAnnouncement&&)> announcement;
+  /// `bytes`: serialised size of the sample, for transfer accounting.
+  std::function<void(wire::SliceFeatures&&, size_t bytes)> slice;
+  std::function<void(wire::ChunkRequest&&)> request;
+  std::function<void(wire::MatchClaim&&)> claim;
+  std::function<void(wire::TransformEstimate&&)> estimate;
+  /// A remote participant appeared (true) or was lost (false); its name is
+  /// "tomomapd/<agent>".
+  std::function<void(const std::string& name, bool alive)> peer;
+};
+
+class Bus {
+ public:
+  /// Creates the participant and every topic, reader and writer; throws
+  /// std::runtime_error if any cannot be created.
+  Bus(const TransportConfig& config, BusHandlers handlers);
+  ~Bus();  ///< deletes every entity and the participant
+  Bus(const Bus&) = delete;
+  Bus& operator=(const Bus&) = delete;
+
+  bool publish(const wire::MapAnnouncement& a);
+  /// Queues a slice sample behind the flow controller; false if the writer's
+  /// queue stayed full (try again later).
+  bool publish(const wire::SliceFeatures& s);
+  bool publish(const wire::ChunkRequest& r);
+  bool publish(const wire::MatchClaim& c);
+  bool publish(const wire::TransformEstimate& e);
+  /// Serialised size of a slice sample [bytes].
+  static size_t serializedSize(const wire::SliceFeatures& s);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tomomap::transport

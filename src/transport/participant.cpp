@@ -1,0 +1,77 @@
+#include "participant.hpp"
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/rtps/flowcontrol/FlowControllerDescriptor.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+namespace tomomap::transport {
+
+using namespace eprosima::fastdds::dds;
+using eprosima::fastrtps::rtps::IPLocator;
+using eprosima::fastrtps::rtps::Locator_t;
+
+const char* const kFlowControllerName = "tomomap_budget";
+
+size_t bytesPerPeriod(double kbps) {
+  return static_cast<size_t>(std::max(1.0, kbps * 1000.0 / 8.0 * kFlowPeriodMs / 1000.0));
+}
+
+size_t maxSampleBytes(double kbps) {
+  constexpr size_t kDatagram = 60000;  // below UDP's 64 KiB with RTPS headers
+  const size_t period = bytesPerPeriod(kbps);
+  const size_t samples_per_period = (period + kDatagram - 1) / kDatagram;
+  return std::max<size_t>(1024, period / samples_per_period - 128);  // 128: RTPS headers
+}
+
+namespace {
+
+Locator_t udp(const std::string& host, uint16_t port) {
+  Locator_t l;
+  l.kind = LOCATOR_KIND_UDPv4;
+  if (!IPLocator::setIPv4(l, host)) throw std::runtime_error("'" + host + "' is not an IPv4 address");
+  l.port = port;
+  return l;
+}
+
+}  // namespace
+
+DomainParticipant* createParticipant(const TransportConfig& c) {
+  DomainParticipantQos q;
+  q.name("tomomapd/" + c.agent);
+  q.transport().use_builtin_transports = false;
+  auto transport = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  transport->sendBufferSize = 1 << 20;
+  transport->receiveBufferSize = 1 << 20;
+  q.transport().user_transports.push_back(transport);
+
+  auto& builtin = q.wire_protocol().builtin;
+  builtin.metatrafficUnicastLocatorList.push_back(udp(c.address, c.discovery_port));
+  q.wire_protocol().default_unicast_locator_list.push_back(udp(c.address, c.data_port));
+  for (const auto& p : c.peers) builtin.initialPeersList.push_back(udp(p.host, p.port));
+  // A lost peer is noticed within seconds, so claims and transfers move on.
+  builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(6, 0);
+  builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(1, 0);
+
+  auto flow = std::make_shared<eprosima::fastdds::rtps::FlowControllerDescriptor>();
+  flow->name = kFlowControllerName;
+  flow->scheduler = eprosima::fastdds::rtps::FlowControllerSchedulerPolicy::FIFO;
+  flow->max_bytes_per_period = static_cast<int32_t>(bytesPerPeriod(c.bandwidth_kbps));
+  flow->period_ms = kFlowPeriodMs;
+  q.flow_controllers().push_back(flow);
+
+  DomainParticipant* p =
+      DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(c.domain), q);
+  if (!p)
+    throw std::runtime_error("cannot create the DDS participant (ports " + std::to_string(c.discovery_port) + "/" +
+                             std::to_string(c.data_port) + " on " + c.address + " in use?)");
+  return p;
+}
+
+}  // namespace tomomap::transport

@@ -1,0 +1,47 @@
+#pragma once
+// A DDS participant that talks only to the peers named in the config: UDPv4
+// unicast on explicit ports, multicast and shared memory off, and a flow
+// controller that holds the configured bandwidth budget (FASTDDS-NOTES.md).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace eprosima::fastdds::dds {
+class DomainParticipant;
+}
+
+namespace tomomap::transport {
+
+struct PeerAddress {
+  std::string id;
+  std::string host;            ///< IPv4 address
+  uint16_t port = 0;           ///< the peer's discovery port
+};
+
+struct TransportConfig {
+  std::string agent;
+  int domain = 0;
+  std::string address = "127.0.0.1";  ///< own IPv4 address, where peers reach us
+  uint16_t discovery_port = 0;
+  uint16_t data_port = 0;
+  std::vector<PeerAddress> peers;
+  double bandwidth_kbps = 10000;     ///< budget for slice data [kbit/s]
+};
+
+/// Flow-controller period [ms]: the budget is enforced per period.
+constexpr int kFlowPeriodMs = 100;
+/// The flow controller's name (a static string: Fast DDS keeps the pointer).
+extern const char* const kFlowControllerName;
+
+/// Bytes the flow controller may send per period.
+size_t bytesPerPeriod(double bandwidth_kbps);
+
+/// Largest slice sample: the per-period budget divided evenly into samples
+/// that fit one UDP datagram, so the controller can reach the budget (it sends
+/// only whole samples per period; FASTDDS-NOTES.md).
+size_t maxSampleBytes(double bandwidth_kbps);
+
+/// Creates the participant; throws std::runtime_error naming the cause.
+eprosima::fastdds::dds::DomainParticipant* createParticipant(const TransportConfig& config);
+
+}  // namespace tomomap::transport

@@ -1,0 +1,284 @@
+#include "slice_codec.hpp"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace tomomap::transport {
+namespace {
+
+constexpr size_t kFeatureBytes = 4 + 32;  // u, v, descriptor
+constexpr size_t kRunBytes = 6;           // u, v, length
+constexpr size_t kMaxFeaturesPerSample = 4096, kMaxRunsPerSample = 16384;  // the IDL bounds
+constexpr size_t kMaxSlices = 4096;
+
+void put16(std::vector<uint8_t>& b, uint16_t v) {
+  b.push_back(static_cast<uint8_t>(v & 0xff));
+  b.push_back(static_cast<uint8_t>(v >> 8));
+}
+
+/// The canonical bytes of a slice's payload, over which the CRC is taken.
+std::vector<uint8_t> canonicalBytes(const std::vector<wire::SliceFeatures>& parts) {
+  std::vector<uint8_t> b;
+  for (const auto& p : parts) {
+    for (const auto& f : p.features()) {
+      put16(b, f.u());
+      put16(b, f.v());
+      b.insert(b.end(), f.descriptor().begin(), f.descriptor().end());
+    }
+    for (const auto& r : p.runs()) {
+      put16(b, r.u());
+      put16(b, r.v());
+      put16(b, r.length());
+    }
+  }
+  return b;
+}
+
+uint32_t crcOf(const std::vector<uint8_t>& bytes) {
+  return static_cast<uint32_t>(crc32(crc32(0L, Z_NULL, 0), bytes.data(), static_cast<uInt>(bytes.size())));
+}
+
+/// Occupied cells of one slice as runs along raster rows.
+std::vector<wire::CellRun> toRuns(const std::vector<uint32_t>& cells, int width) {
+  std::vector<wire::CellRun> runs;
+  const auto w = static_cast<uint32_t>(width);
+  for (size_t i = 0; i < cells.size();) {
+    size_t j = i + 1;
+    while (j < cells.size() && cells[j] == cells[j - 1] + 1 && cells[j] / w == cells[i] / w &&
+           j - i < 0xffff)
+      ++j;
+    wire::CellRun r;
+    r.u(static_cast<uint16_t>(cells[i] % w));
+    r.v(static_cast<uint16_t>(cells[i] / w));
+    r.length(static_cast<uint16_t>(j - i));
+    runs.push_back(r);
+    i = j;
+  }
+  return runs;
+}
+
+template <typename T>
+std::vector<std::vector<T>> split(const std::vector<T>& items, size_t per_part) {
+  std::vector<std::vector<T>> parts;
+  for (size_t i = 0; i < items.size(); i += per_part)
+    parts.emplace_back(items.begin() + static_cast<long>(i),
+                       items.begin() + static_cast<long>(std::min(items.size(), i + per_part)));
+  if (parts.empty()) parts.emplace_back();
+  return parts;
+}
+
+}  // namespace
+
+size_t sampleOverhead() { return 256; }
+
+MapOffer makeOffer(const std::string& agent, const MapFeatures& f, uint64_t raw_bytes, size_t max_sample_bytes) {
+  const SliceGrid& g = f.occupancy.grid;
+  const size_t room = max_sample_bytes > sampleOverhead() + kFeatureBytes ? max_sample_bytes - sampleOverhead()
+                                                                           : kFeatureBytes;
+  const size_t features_per_part = std::clamp<size_t>(room / kFeatureBytes, 1, kMaxFeaturesPerSample);
+  const size_t runs_per_part = std::clamp<size_t>(room / kRunBytes, 1, kMaxRunsPerSample);
+
+  MapOffer offer;
+  auto& a = offer.announcement;
+  a.agent(agent);
+  a.grid(f.grid);
+  a.x_min(g.x_min);
+  a.y_min(g.y_min);
+  a.z_min(f.z_min);
+  a.width(static_cast<uint16_t>(g.width));
+  a.height(static_cast<uint16_t>(g.height));
+  a.slice_count(f.slice_count);
+  a.raw_bytes(raw_bytes);
+
+  // Most informative first: a receiver that gets only part of the map early
+  // holds the slices most likely to match.
+  std::vector<const SliceFeatures*> order;
+  for (const auto& s : f.slices) order.push_back(&s);
+  std::stable_sort(order.begin(), order.end(), [](const SliceFeatures* x, const SliceFeatures* y) {
+    return x->keypoints.size() > y->keypoints.size();
+  });
+  if (order.size() > kMaxSlices) order.resize(kMaxSlices);
+
+  for (const SliceFeatures* s : order) {
+    std::vector<wire::Feature> feats;
+    feats.reserve(s->keypoints.size());
+    for (size_t i = 0; i < s->keypoints.size(); ++i) {
+      wire::Feature w;
+      // Keypoints sit on pixel centres (single-level ORB): exact round trip.
+      w.u(static_cast<uint16_t>(std::lround((s->keypoints[i].x() - g.x_min) / g.cell - 0.5)));
+      w.v(static_cast<uint16_t>(std::lround((s->keypoints[i].y() - g.y_min) / g.cell - 0.5)));
+      std::copy_n(s->descriptors.ptr<uint8_t>(static_cast<int>(i)), 32, w.descriptor().begin());
+      feats.push_back(w);
+    }
+    const auto& cells = f.occupancy.cells.at(static_cast<size_t>(s->index));
+    std::vector<wire::CellRun> runs = toRuns(cells, g.width);
+    const bool as_cells = !cells.empty() && runs.size() * kRunBytes < feats.size() * kFeatureBytes;
+
+    std::vector<wire::SliceFeatures> samples;
+    auto base = [&](size_t part, size_t parts) {
+      wire::SliceFeatures x;
+      x.agent(agent);
+      x.slice(s->index);
+      x.part(static_cast<uint16_t>(part));
+      x.parts(static_cast<uint16_t>(parts));
+      x.encoding(as_cells ? wire::SliceEncoding::OCCUPANCY : wire::SliceEncoding::FEATURES);
+      return x;
+    };
+    if (as_cells) {
+      const auto parts = split(runs, runs_per_part);
+      for (size_t p = 0; p < parts.size(); ++p) samples.push_back(base(p, parts.size())), samples.back().runs(parts[p]);
+    } else {
+      const auto parts = split(feats, features_per_part);
+      for (size_t p = 0; p < parts.size(); ++p)
+        samples.push_back(base(p, parts.size())), samples.back().features(parts[p]);
+    }
+    const auto bytes = canonicalBytes(samples);
+    wire::SliceEntry e;
+    e.slice(s->index);
+    e.parts(static_cast<uint16_t>(samples.size()));
+    e.bytes(static_cast<uint32_t>(bytes.size()));
+    e.crc32(crcOf(bytes));
+    a.slices().push_back(e);
+    offer.payload_bytes += bytes.size();
+    offer.samples[s->index] = std::move(samples);
+  }
+  a.version(mapVersion(a));
+  for (auto& [k, samples] : offer.samples)
+    for (auto& x : samples) x.version(a.version());
+  return offer;
+}
+
+uint64_t mapVersion(const wire::MapAnnouncement& a) {
+  // FNV-1a over the raster geometry and every slice's index and CRC.
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](uint64_t v) {
+    for (int i = 0; i < 8; ++i) {
+      h ^= (v >> (8 * i)) & 0xff;
+      h *= 1099511628211ull;
+    }
+  };
+  auto bits = [](double d) {
+    uint64_t u;
+    std::memcpy(&u, &d, sizeof u);
+    return u;
+  };
+  mix(bits(a.grid()));
+  mix(bits(a.x_min()));
+  mix(bits(a.y_min()));
+  mix(bits(a.z_min()));
+  mix((uint64_t{a.width()} << 16) | a.height());
+  for (const auto& e : a.slices()) mix((uint64_t{static_cast<uint32_t>(e.slice())} << 32) | e.crc32());
+  return h;
+}
+
+Rejection validate(const wire::MapAnnouncement& a) {
+  if (!(a.grid() > 0) || !std::isfinite(a.grid()) || !std::isfinite(a.x_min()) || !std::isfinite(a.y_min()) ||
+      !std::isfinite(a.z_min()))
+    return "announcement with a bad grid or origin";
+  if (a.width() == 0 || a.height() == 0 || a.width() > kMaxImageSide || a.height() > kMaxImageSide)
+    return "announcement with a bad raster size";
+  if (a.slice_count() <= 0 || a.slice_count() > 100000) return "announcement with a bad slice count";
+  std::set<int> seen;
+  for (const auto& e : a.slices()) {
+    if (e.slice() < 0 || e.slice() >= a.slice_count() || !seen.insert(e.slice()).second)
+      return "announcement lists slice " + std::to_string(e.slice()) + " out of range or twice";
+    if (e.parts() == 0 || e.parts() > 1024) return "announcement with a bad part count";
+    // A slice can never need more than its raster in runs or ORB's cap in features.
+    const size_t cap = std::max<size_t>(size_t{a.width()} * a.height() * kRunBytes, 100000 * kFeatureBytes);
+    if (e.bytes() > cap) return "announcement with an oversized slice";
+  }
+  if (a.version() != mapVersion(a)) return "announcement whose version does not match its content";
+  return {};
+}
+
+Reassembler::Reassembler(wire::MapAnnouncement announcement) : announcement_(std::move(announcement)) {
+  for (size_t i = 0; i < announcement_.slices().size(); ++i) entries_[announcement_.slices()[i].slice()] = i;
+}
+
+Rejection Reassembler::accept(const wire::SliceFeatures& x) {
+  const auto it = entries_.find(x.slice());
+  if (it == entries_.end()) return "slice " + std::to_string(x.slice()) + " was not announced";
+  const wire::SliceEntry& e = announcement_.slices()[it->second];
+  if (x.parts() != e.parts() || x.part() >= e.parts()) return "part numbering differs from the announcement";
+  const bool cells = x.encoding() == wire::SliceEncoding::OCCUPANCY;
+  if ((cells && !x.features().empty()) || (!cells && !x.runs().empty())) return "sample mixes encodings";
+  for (const auto& r : x.runs())
+    if (r.length() == 0 || size_t{r.u()} + r.length() > announcement_.width() || r.v() >= announcement_.height())
+      return "cell run outside the raster";
+  for (const auto& f : x.features())
+    if (f.u() >= announcement_.width() || f.v() >= announcement_.height()) return "keypoint outside the raster";
+  if (done_.count(x.slice())) return {};  // a duplicate of a verified slice
+
+  Partial& p = partial_[x.slice()];
+  p.parts.resize(e.parts());
+  auto& slot = p.parts[x.part()];
+  if (slot) return {};  // duplicate part
+  const size_t bytes = x.features().size() * kFeatureBytes + x.runs().size() * kRunBytes;
+  size_t held = 0;
+  for (const auto& q : p.parts)
+    if (q) held += q->features().size() * kFeatureBytes + q->runs().size() * kRunBytes;
+  if (held + bytes > e.bytes()) {
+    partial_.erase(x.slice());
+    return "slice larger than announced";
+  }
+  slot = x;
+  ++p.received;
+  bytes_received_ += bytes;
+  if (p.received < e.parts()) return {};
+
+  std::vector<wire::SliceFeatures> parts;
+  for (auto& q : p.parts) parts.push_back(std::move(*q));
+  partial_.erase(x.slice());
+  const auto canonical = canonicalBytes(parts);
+  if (canonical.size() != e.bytes() || crcOf(canonical) != e.crc32()) return "slice checksum mismatch";
+  done_[x.slice()] = std::move(parts);
+  return {};
+}
+
+std::vector<int32_t> Reassembler::missing() const {
+  std::vector<int32_t> out;
+  for (const auto& e : announcement_.slices())
+    if (!done_.count(e.slice())) out.push_back(e.slice());
+  return out;
+}
+
+MapFeatures Reassembler::build(const FeatureParams& params) const {
+  const auto& a = announcement_;
+  SliceStack stack;
+  stack.grid = {a.grid(), a.x_min(), a.y_min(), a.z_min(), a.width(), a.height()};
+  stack.cells.resize(static_cast<size_t>(a.slice_count()));
+  std::vector<SliceFeatures> sent_as_features;
+  for (const auto& [index, parts] : done_) {
+    if (parts.front().encoding() == wire::SliceEncoding::OCCUPANCY) {
+      auto& cells = stack.cells[static_cast<size_t>(index)];
+      for (const auto& p : parts)
+        for (const auto& r : p.runs())
+          for (uint32_t k = 0; k < r.length(); ++k) cells.push_back(uint32_t{r.v()} * a.width() + r.u() + k);
+      std::sort(cells.begin(), cells.end());
+      cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    } else {
+      SliceFeatures s;
+      s.index = index;
+      size_t n = 0;
+      for (const auto& p : parts) n += p.features().size();
+      s.descriptors = cv::Mat(static_cast<int>(n), 32, CV_8U);
+      int row = 0;
+      for (const auto& p : parts)
+        for (const auto& f : p.features()) {
+          s.keypoints.push_back(stack.grid.toMetres(f.u(), f.v()));
+          std::copy(f.descriptor().begin(), f.descriptor().end(), s.descriptors.ptr<uint8_t>(row++));
+        }
+      sent_as_features.push_back(std::move(s));
+    }
+  }
+  MapFeatures out = extractFeatures(std::move(stack), params);
+  for (auto& s : sent_as_features) out.slices.push_back(std::move(s));
+  std::sort(out.slices.begin(), out.slices.end(),
+            [](const SliceFeatures& x, const SliceFeatures& y) { return x.index < y.index; });
+  return out;
+}
+
+}  // namespace tomomap::transport
