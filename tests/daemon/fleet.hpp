@@ -1,0 +1,155 @@
+#pragma once
+// Real tomomapd processes on loopback for the multi-process tests: configs
+// written to a temporary folder, distinct ports per test process, and every
+// process killed when the test ends, pass or fail.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "support.hpp"
+
+namespace tomomap::test {
+
+struct AgentSpec {
+  std::string id, map;
+  double grid = 0.05;
+  double bandwidth_kbps = 10000;
+  std::vector<std::string> peers;  ///< ids it lists; all of the fleet's others by default
+
+  AgentSpec(std::string id_, std::string map_, double grid_ = 0.05, double kbps = 10000,
+            std::vector<std::string> peers_ = {})
+      : id(std::move(id_)), map(std::move(map_)), grid(grid_), bandwidth_kbps(kbps), peers(std::move(peers_)) {}
+};
+
+class Fleet {
+ public:
+  explicit Fleet(TempDir& dir) : dir_(dir) {
+    // Ports apart per test process: ctest runs tests side by side.
+    base_port_ = static_cast<uint16_t>(23000 + (::getpid() % 400) * 40);
+  }
+  ~Fleet() {
+    std::vector<std::string> ids;
+    for (const auto& [id, pid] : pids_) ids.push_back(id);
+    for (const auto& id : ids) kill(id, SIGKILL);
+  }
+
+  uint16_t port(size_t index) const { return static_cast<uint16_t>(base_port_ + 4 * index); }
+
+  /// Writes the config of `spec`; `everyone` lists the fleet (for ports).
+  std::string writeConfig(const AgentSpec& spec, const std::vector<AgentSpec>& everyone) {
+    std::ostringstream c;
+    c << "agent = \"" << spec.id << "\"\nmap = \"" << spec.map << "\"\ngrid = " << spec.grid
+      << "\ndiscovery_port = " << port(indexOf(spec.id, everyone)) << "\nbandwidth_kbps = " << spec.bandwidth_kbps
+      << "\noutput_dir = \"" << (dir_ / ("out-" + spec.id)) << "\"\nrequest_interval_s = 1\nclaim_timeout_s = 8\n";
+    for (const auto& other : everyone) {
+      if (other.id == spec.id) continue;
+      if (!spec.peers.empty() && std::find(spec.peers.begin(), spec.peers.end(), other.id) == spec.peers.end())
+        continue;
+      c << "[[peer]]\nid = \"" << other.id << "\"\nhost = \"127.0.0.1\"\nport = " << port(indexOf(other.id, everyone))
+        << "\n";
+    }
+    const std::string path = dir_ / (spec.id + ".toml");
+    std::ofstream(path) << c.str();
+    return path;
+  }
+
+  void start(const AgentSpec& spec, const std::vector<AgentSpec>& everyone) {
+    const std::string config = writeConfig(spec, everyone);
+    const std::string log = dir_ / (spec.id + ".log");
+    const pid_t pid = fork();
+    if (pid == 0) {
+      FILE* f = freopen(log.c_str(), "a", stderr);
+      (void)f;
+      execl(TOMOMAPD_BIN, TOMOMAPD_BIN, "--config", config.c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    pids_[spec.id] = pid;
+  }
+
+  /// Sends `sig`; for SIGKILL also reaps the process.
+  void kill(const std::string& id, int sig) {
+    const auto it = pids_.find(id);
+    if (it == pids_.end()) return;
+    ::kill(it->second, sig);
+    if (sig == SIGKILL) {
+      waitpid(it->second, nullptr, 0);
+      pids_.erase(it);
+    }
+  }
+
+  /// Waits for `id` to exit; returns its exit code, or nullopt after `timeout`.
+  std::optional<int> waitExit(const std::string& id, std::chrono::milliseconds timeout) {
+    const auto it = pids_.find(id);
+    if (it == pids_.end()) return std::nullopt;
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < until) {
+      int status = 0;
+      if (waitpid(it->second, &status, WNOHANG) == it->second) {
+        pids_.erase(it);
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return std::nullopt;
+  }
+
+  nlohmann::json readJson(const std::string& id, const std::string& file) const {
+    std::ifstream in(dir_ / ("out-" + id + "/" + file));
+    if (!in) return {};
+    try {
+      return nlohmann::json::parse(in);
+    } catch (...) {
+      return {};
+    }
+  }
+
+  /// The transforms `id` has stored, by "target<-source".
+  std::map<std::string, nlohmann::json> transforms(const std::string& id) const {
+    std::map<std::string, nlohmann::json> out;
+    const auto j = readJson(id, "transforms.json");
+    if (j.contains("transforms"))
+      for (const auto& t : j["transforms"])
+        out[t["target"].get<std::string>() + "<-" + t["source"].get<std::string>()] = t;
+    return out;
+  }
+
+  /// Polls until every agent in `ids` stores `pairs` transforms, or `timeout`.
+  bool waitForTransforms(const std::vector<std::string>& ids, size_t pairs, std::chrono::seconds timeout) const {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < until) {
+      bool all = true;
+      for (const auto& id : ids) all = all && transforms(id).size() >= pairs;
+      if (all) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return false;
+  }
+
+  std::string log(const std::string& id) const {
+    std::ifstream in(dir_ / (id + ".log"));
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+
+ private:
+  static size_t indexOf(const std::string& id, const std::vector<AgentSpec>& everyone) {
+    for (size_t i = 0; i < everyone.size(); ++i)
+      if (everyone[i].id == id) return i;
+    return everyone.size();
+  }
+
+  TempDir& dir_;
+  uint16_t base_port_;
+  std::map<std::string, pid_t> pids_;
+};
+
+}  // namespace tomomap::test

@@ -1,0 +1,160 @@
+// tomomapd as deployed: separate processes, real Fast DDS participants on
+// loopback UDP, real map files, results read from the files users read.
+#include <gtest/gtest.h>
+
+#include "fleet.hpp"
+
+using namespace tomomap;
+using namespace tomomap::test;
+using namespace std::chrono_literals;
+
+namespace {
+
+Pose4 poseOf(const nlohmann::json& t) {
+  const auto& T = t["T_target_source"];
+  return {T["x"].get<double>(), T["y"].get<double>(), T["z"].get<double>(), T["yaw"].get<double>()};
+}
+
+/// Ground truth T_target_source for maps written by `tomomap synth` or demo-room.
+Pose4 truth(const std::string& target_pose, const std::string& source_pose) {
+  return Pose4::fromMatrix(loadPoseFile(target_pose) * loadPoseFile(source_pose).inverse());
+}
+
+/// Stops every agent with SIGTERM and checks each leaves within 2 s, cleanly.
+void stopAll(Fleet& fleet, const std::vector<std::string>& ids) {
+  for (const auto& id : ids) fleet.kill(id, SIGTERM);
+  for (const auto& id : ids) {
+    const auto code = fleet.waitExit(id, 2000ms);
+    ASSERT_TRUE(code.has_value()) << id << " did not stop within 2 s\n" << fleet.log(id);
+    EXPECT_EQ(*code, 0) << fleet.log(id);
+    EXPECT_NE(fleet.log(id).find("stopped"), std::string::npos);
+  }
+}
+
+/// Total matches computed across the fleet (from each agent's status).
+int computedAcrossFleet(const Fleet& fleet, const std::vector<std::string>& ids) {
+  int n = 0;
+  for (const auto& id : ids) n += fleet.readJson(id, "status.json").value("matches_computed", 0);
+  return n;
+}
+
+}  // namespace
+
+TEST(Daemons, TwoAgreeOnDemoRoomAndStopCleanly) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  Fleet fleet(dir);
+  const std::string d = demoRoom() + "/";
+  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd"}, {"bravo", d + "demo-pcd2.pcd"}};
+  for (const auto& a : agents) fleet.start(a, agents);
+  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 60s)) << fleet.log("alpha") << fleet.log("bravo");
+
+  const auto a = fleet.transforms("alpha").at("alpha<-bravo");
+  const auto b = fleet.transforms("bravo").at("alpha<-bravo");
+  ASSERT_TRUE(a["reliable"].get<bool>()) << a.dump(2);
+  const PoseError e = poseError(poseOf(a), truth(d + "demo-pcd1-gtpose.txt", d + "demo-pcd2-gtpose.txt"));
+  EXPECT_LT(e.translation, 0.05);
+  EXPECT_LT(e.yaw, 0.02);
+  // Both store the same agreed result, computed once, by the lower id.
+  EXPECT_EQ(a["T_target_source"], b["T_target_source"]);
+  EXPECT_EQ(a["computed_by"], "alpha");
+  EXPECT_EQ(computedAcrossFleet(fleet, {"alpha", "bravo"}), 1);
+  // The wire carried compact features, not the map.
+  const auto s = fleet.readJson("bravo", "status.json");
+  EXPECT_LT(s["map"]["payload_bytes"].get<double>(), 0.25 * s["map"]["raw_bytes"].get<double>()) << s.dump(2);
+  stopAll(fleet, {"alpha", "bravo"});
+}
+
+TEST(Daemons, ThreeAgreeOnASynthWorldWithALateJoiner) {
+  TempDir dir;
+  const auto gen = runTomomap("synth -o " + (dir / "world") + " -n 3 --noise low -s 4");
+  ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  Fleet fleet(dir);
+  std::vector<AgentSpec> agents;
+  for (const char* id : {"alpha", "bravo", "charlie"})
+    agents.push_back({id, dir / ("world/map_" + std::to_string(agents.size()) + ".pcd")});
+  fleet.start(agents[0], agents);
+  fleet.start(agents[1], agents);
+  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 90s)) << fleet.log("alpha") << fleet.log("bravo");
+  // charlie joins after alpha<-bravo was agreed: it gets that result and its own pairs.
+  fleet.start(agents[2], agents);
+  const std::vector<std::string> ids{"alpha", "bravo", "charlie"};
+  ASSERT_TRUE(fleet.waitForTransforms(ids, 3, 120s)) << fleet.log("alpha") << fleet.log("charlie");
+
+  const auto gt = [&](int i) { return dir / ("world/map_" + std::to_string(i) + "-gtpose.txt"); };
+  const std::map<std::string, std::pair<int, int>> pairs{
+      {"alpha<-bravo", {0, 1}}, {"alpha<-charlie", {0, 2}}, {"bravo<-charlie", {1, 2}}};
+  for (const auto& [name, idx] : pairs) {
+    const auto ref = fleet.transforms("alpha").at(name);
+    for (const auto& id : ids) EXPECT_EQ(fleet.transforms(id).at(name)["T_target_source"], ref["T_target_source"]);
+    if (!ref["reliable"].get<bool>()) continue;  // maps 0 and 2 may not overlap enough
+    const PoseError e = poseError(poseOf(ref), truth(gt(idx.first), gt(idx.second)));
+    EXPECT_LT(e.translation, 5 * 0.05) << name;
+    EXPECT_LT(e.yaw, 10 * kPi / 180) << name;
+  }
+  EXPECT_TRUE(fleet.transforms("alpha").at("alpha<-bravo")["reliable"].get<bool>());
+  EXPECT_EQ(computedAcrossFleet(fleet, ids), 3) << "each pair exactly once";
+  stopAll(fleet, ids);
+}
+
+TEST(Daemons, AReceiverKilledMidTransferCompletesAfterRestart) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  Fleet fleet(dir);
+  const std::string d = demoRoom() + "/";
+  // 200 kbit/s: about 5 s for the ~120 kB of features, time to kill mid-way.
+  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd", 0.05, 200},
+                                      {"bravo", d + "demo-pcd2.pcd", 0.05, 200}};
+  for (const auto& a : agents) fleet.start(a, agents);
+  const auto until = std::chrono::steady_clock::now() + 20s;
+  int received = 0;
+  while (std::chrono::steady_clock::now() < until && received == 0) {
+    const auto s = fleet.readJson("bravo", "status.json");
+    if (s.contains("peers") && s["peers"]["alpha"].contains("slices_received"))
+      received = s["peers"]["alpha"]["slices_received"].get<int>();
+    std::this_thread::sleep_for(50ms);
+  }
+  ASSERT_GT(received, 0) << fleet.log("bravo");
+  fleet.kill("bravo", SIGKILL);
+  EXPECT_TRUE(fleet.transforms("alpha").empty()) << "killed before the transfer ended";
+  fleet.start(agents[1], agents);
+  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 90s)) << fleet.log("alpha") << fleet.log("bravo");
+  const auto t = fleet.transforms("bravo").at("alpha<-bravo");
+  ASSERT_TRUE(t["reliable"].get<bool>());
+  EXPECT_LT(poseError(poseOf(t), truth(d + "demo-pcd1-gtpose.txt", d + "demo-pcd2-gtpose.txt")).translation, 0.05);
+  stopAll(fleet, {"alpha", "bravo"});
+}
+
+TEST(Daemons, SamplesFromAnAgentNotInTheConfigAreDroppedAndCounted) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  Fleet fleet(dir);
+  const std::string d = demoRoom() + "/";
+  // mallory lists alpha, but alpha does not list mallory.
+  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd", 0.05, 10000, {"bravo"}},
+                                      {"bravo", d + "demo-pcd2.pcd", 0.05, 10000, {"alpha"}},
+                                      {"mallory", d + "demo-pcd2.pcd", 0.05, 10000, {"alpha"}}};
+  for (const auto& a : agents) fleet.start(a, agents);
+  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 60s)) << fleet.log("alpha");
+  std::this_thread::sleep_for(2s);
+  const auto s = fleet.readJson("alpha", "status.json");
+  EXPECT_GT(s["dropped_unknown_agent"].get<int>(), 0) << s.dump(2);
+  EXPECT_EQ(fleet.transforms("alpha").size(), 1u);
+  EXPECT_EQ(fleet.transforms("alpha").count("alpha<-mallory"), 0u);
+  stopAll(fleet, {"alpha", "bravo", "mallory"});
+}
+
+TEST(Daemons, BadConfigNamesFileLineAndKey) {
+  TempDir dir;
+  std::ofstream(dir / "bad.toml") << "agent = \"alpha\"\nmap = \"x.pcd\"\ndiscovery_port = \"many\"\n";
+  const auto r = runBinary(TOMOMAPD_BIN, "--config " + (dir / "bad.toml"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("bad.toml:3:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("discovery_port"), std::string::npos) << r.output;
+
+  std::ofstream(dir / "missing.toml") << "agent = \"alpha\"\nmap = \"/nonexistent.pcd\"\ndiscovery_port = 24000\n"
+                                      << "output_dir = \"" << (dir / "out") << "\"\n";
+  const auto m = runBinary(TOMOMAPD_BIN, "--config " + (dir / "missing.toml"));
+  EXPECT_EQ(m.exit_code, 2);
+  EXPECT_NE(m.output.find("no such file"), std::string::npos) << m.output;
+}

@@ -1,0 +1,59 @@
+// tomomapd's config file: defaults, errors with file, line and key.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "config.hpp"
+#include "support.hpp"
+
+using namespace tomomap;
+using namespace tomomap::daemon;
+using tomomap::test::TempDir;
+
+namespace {
+
+std::string errorOf(TempDir& dir, const std::string& text) {
+  std::ofstream(dir / "c.toml") << text;
+  try {
+    loadConfig(dir / "c.toml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(DaemonConfig, MinimalConfigGetsDefaults) {
+  TempDir dir;
+  std::ofstream(dir / "c.toml") << "agent = \"alpha\"\nmap = \"maps/a.pcd\"\ndiscovery_port = 17500\n"
+                                << "[[peer]]\nid = \"bravo\"\nhost = \"10.0.0.2\"\nport = 17500\n";
+  const Config c = loadConfig(dir / "c.toml");
+  EXPECT_EQ(c.agent(), "alpha");
+  EXPECT_EQ(c.map, dir / "maps/a.pcd");  // relative to the config file
+  EXPECT_EQ(c.transport.data_port, 17501);
+  EXPECT_DOUBLE_EQ(c.grid, 0.05);
+  EXPECT_DOUBLE_EQ(c.transport.bandwidth_kbps, 10000);
+  ASSERT_EQ(c.transport.peers.size(), 1u);
+  EXPECT_TRUE(c.isPeer("bravo"));
+  EXPECT_FALSE(c.isPeer("mallory"));
+}
+
+TEST(DaemonConfig, ErrorsNameFileLineAndKey) {
+  TempDir dir;
+  std::string e = errorOf(dir, "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 80\n");
+  EXPECT_NE(e.find("c.toml:3:"), std::string::npos) << e;
+  EXPECT_NE(e.find("'discovery_port'"), std::string::npos) << e;
+  e = errorOf(dir, "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\ncolour = 3\n");
+  EXPECT_NE(e.find("c.toml:4:"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown key"), std::string::npos) << e;
+  e = errorOf(dir, "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n[[peer]]\nid = \"b\"\nhost = \"nowhere\"\nport = 1\n");
+  EXPECT_NE(e.find("c.toml:6:"), std::string::npos) << e;
+  EXPECT_NE(e.find("IPv4"), std::string::npos) << e;
+  e = errorOf(dir, "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n[[peer]]\nid = \"alpha\"\nhost = \"1.2.3.4\"\nport = 17600\n");
+  EXPECT_NE(e.find("own id"), std::string::npos) << e;
+  e = errorOf(dir, "agent = \"alpha\"\nmap = [1\n");
+  EXPECT_NE(e.find("c.toml:2:"), std::string::npos) << e;
+  e = errorOf(dir, "map = \"a.pcd\"\ndiscovery_port = 17500\n");
+  EXPECT_NE(e.find("'agent' is required"), std::string::npos) << e;
+}

@@ -1,0 +1,128 @@
+// Wire encoding, chunking and reassembly without a network.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "core/matcher.hpp"
+#include "support.hpp"
+#include "synth/synth.hpp"
+#include "transport/participant.hpp"
+#include "transport/slice_codec.hpp"
+
+using namespace tomomap;
+using namespace tomomap::transport;
+
+namespace {
+
+/// A small generated map described at g = 0.1.
+const MapFeatures& sampleMap() {
+  static const MapFeatures f = [] {
+    synth::SceneParams sp;
+    sp.scale = 0.5;
+    const synth::Scene scene = synth::makeScene(sp);
+    const Points map = synth::scanScene(scene, synth::noiseLevel("low"), 1).front().points;
+    MatchParams p;
+    p.grid = 0.1;
+    return describeMap(map, p);
+  }();
+  return f;
+}
+
+Reassembler receiveAll(const MapOffer& offer, bool shuffle) {
+  Reassembler r(offer.announcement);
+  std::vector<wire::SliceFeatures> all;
+  for (const auto& [k, samples] : offer.samples) all.insert(all.end(), samples.begin(), samples.end());
+  if (shuffle) std::shuffle(all.begin(), all.end(), std::mt19937(7));
+  for (const auto& s : all) EXPECT_EQ(r.accept(s), "");
+  return r;
+}
+
+}  // namespace
+
+TEST(SliceCodec, RoundTripGivesTheSameFeaturesInAnyOrder) {
+  const MapFeatures& f = sampleMap();
+  const MapOffer offer = makeOffer("alpha", f, 1000000, 4000);
+  EXPECT_EQ(validate(offer.announcement), "");
+  const Reassembler r = receiveAll(offer, /*shuffle=*/true);
+  ASSERT_TRUE(r.complete());
+  const MapFeatures back = r.build({});
+  ASSERT_EQ(back.slices.size(), f.slices.size());
+  for (size_t i = 0; i < f.slices.size(); ++i) {
+    EXPECT_EQ(back.slices[i].index, f.slices[i].index);
+    ASSERT_EQ(back.slices[i].keypoints.size(), f.slices[i].keypoints.size());
+    EXPECT_LT((back.slices[i].keypoints[0] - f.slices[i].keypoints[0]).norm(), 1e-4);
+    EXPECT_EQ(cv::norm(back.slices[i].descriptors, f.slices[i].descriptors, cv::NORM_HAMMING), 0);
+  }
+  // Matching the received copy against the original finds the identity.
+  MatchParams p;
+  p.grid = 0.1;
+  const MatchResult m = matchFeatures(f, back, p);
+  ASSERT_TRUE(m.reliable) << m.reason;
+  EXPECT_LT(std::hypot(m.T_target_source.x, m.T_target_source.y), 0.01);
+}
+
+TEST(SliceCodec, SamplesFitTheBudgetAndTheCheaperEncodingIsChosen) {
+  const MapFeatures& f = sampleMap();
+  const size_t budget = maxSampleBytes(1000);  // 1 Mbit/s
+  EXPECT_LE(budget, bytesPerPeriod(1000));
+  const MapOffer offer = makeOffer("alpha", f, 1000000, budget);
+  size_t features = 0, occupancy = 0;
+  for (const auto& [k, samples] : offer.samples)
+    for (const auto& s : samples) {
+      EXPECT_LE(wire::SliceFeatures::getCdrSerializedSize(s), budget);
+      (s.encoding() == wire::SliceEncoding::OCCUPANCY ? occupancy : features)++;
+    }
+  EXPECT_GT(occupancy + features, 0u);
+  size_t feature_bytes = 36 * f.featureCount();
+  EXPECT_LE(offer.payload_bytes, feature_bytes) << "never more than sending every feature";
+}
+
+TEST(SliceCodec, InconsistentSamplesAreRejectedNotCrashed) {
+  const MapOffer offer = makeOffer("alpha", sampleMap(), 1000000, 4000);
+  Reassembler r(offer.announcement);
+  wire::SliceFeatures s = offer.samples.begin()->second.front();
+
+  wire::SliceFeatures unknown = s;
+  unknown.slice(100000);
+  EXPECT_NE(r.accept(unknown), "");
+  wire::SliceFeatures parts = s;
+  parts.parts(static_cast<uint16_t>(parts.parts() + 1));
+  EXPECT_NE(r.accept(parts), "");
+  wire::SliceFeatures outside = s;
+  wire::CellRun run;
+  run.u(65000);
+  run.v(1);
+  run.length(10);
+  outside.encoding(wire::SliceEncoding::OCCUPANCY);
+  outside.features({});
+  outside.runs({run});
+  EXPECT_NE(r.accept(outside), "");
+
+  // A corrupted payload is caught by the CRC once the slice is whole.
+  wire::SliceFeatures corrupt = s;
+  if (!corrupt.features().empty()) corrupt.features()[0].descriptor()[0] ^= 0xff;
+  if (!corrupt.runs().empty()) {
+    auto& r0 = corrupt.runs()[0];
+    r0.u(static_cast<uint16_t>(r0.u() > 0 ? r0.u() - 1 : r0.u() + 1));  // same size, other cells
+  }
+  std::string verdict;
+  for (uint16_t p = 0; p < s.parts(); ++p) {
+    wire::SliceFeatures x = p == s.part() ? corrupt : offer.samples.begin()->second[p];
+    verdict = r.accept(x);
+  }
+  EXPECT_NE(verdict, "");
+  EXPECT_FALSE(r.complete());
+  EXPECT_EQ(r.missing().size(), offer.announcement.slices().size());
+
+  // Announcements that lie are refused before anything is allocated.
+  wire::MapAnnouncement a = offer.announcement;
+  a.grid(std::nan(""));
+  EXPECT_NE(validate(a), "");
+  a = offer.announcement;
+  a.width(0);
+  EXPECT_NE(validate(a), "");
+  a = offer.announcement;
+  a.version(a.version() + 1);
+  EXPECT_NE(validate(a), "");
+}
