@@ -117,7 +117,7 @@ void Agent::onAnnouncement(wire::MapAnnouncement&& a) {
   r.owner(p.incoming->announcement().agent().to_string());
   r.version(p.incoming->announcement().version());
   bus_->publish(r);
-  p.last_request = Clock::now();
+  p.last_request = p.requested = Clock::now();
 }
 
 void Agent::onSlice(wire::SliceFeatures&& s, size_t bytes) {
@@ -129,19 +129,16 @@ void Agent::onSlice(wire::SliceFeatures&& s, size_t bytes) {
   if (p.features) return;  // complete already: a resend meant for another peer
   if (const auto why = p.incoming->accept(s); !why.empty()) return reject(s.agent().to_string(), why);
   const auto now = Clock::now();
-  if (p.samples++ == 0) {
-    p.first_slice = now;
-    p.first_slice_bytes = bytes;
-  }
+  if (p.samples++ == 0) p.first_slice = now;
   p.bytes += bytes;
   p.last_slice = p.last_progress = now;
   if (!p.incoming->complete()) return;
   p.features = std::make_shared<MapFeatures>(p.incoming->build({}));
-  const double span = seconds(p.last_slice - p.first_slice);
-  const double rate = span > 0 ? static_cast<double>(p.bytes - p.first_slice_bytes) * 8 / 1000 / span : 0;
+  const double span = seconds(p.last_slice - p.requested);
+  const double rate = rateKbps(p);
   log_.info("received the map of " + s.agent().to_string() + ": " + std::to_string(p.incoming->sliceCount()) + " slices, " +
-            std::to_string(p.bytes) + " bytes in " + std::to_string(p.samples) + " samples over " + fixed(span, 2) +
-            " s (" + fixed(rate, 0) + " kbit/s)");
+            std::to_string(p.bytes) + " bytes in " + std::to_string(p.samples) + " samples, " + fixed(span, 2) +
+            " s after our request (" + fixed(rate, 0) + " kbit/s while sending)");
 }
 
 void Agent::onRequest(wire::ChunkRequest&& r) {
@@ -206,6 +203,7 @@ void Agent::onPeer(const std::string& name, bool alive) {
   }
   if (alive) {
     if (alive_.insert(id).second) log_.info("peer " + id + " is up");
+    requestMissing(/*at_once=*/true);  // a request sent before it could hear us was lost
     // A late joiner gets what this agent computed, in case durability missed it.
     for (const auto& [key, e] : results_)
       if (e.computed_by().to_string() == config_.agent()) bus_->publish(e);
@@ -231,12 +229,18 @@ void Agent::pumpSends() {
   }
 }
 
-void Agent::requestMissing() {
+double Agent::rateKbps(const PeerMap& p) const {
+  if (p.samples < 2) return 0;
+  const double span = seconds(p.last_slice - p.first_slice) + transport::kFlowPeriodMs / 1000.0;
+  return static_cast<double>(p.bytes) * 8 / 1000 / span;
+}
+
+void Agent::requestMissing(bool at_once) {
   const auto now = Clock::now();
   for (auto& [id, p] : peers_) {
     if (!p.incoming || p.features) continue;
     const auto quiet_since = std::max(p.last_progress, p.last_request);
-    if (seconds(now - quiet_since) < config_.request_interval_s) continue;
+    if (!at_once && seconds(now - quiet_since) < config_.request_interval_s) continue;
     wire::ChunkRequest r;
     r.requester(config_.agent());
     r.owner(id);
@@ -367,7 +371,7 @@ void Agent::persist(bool transforms_changed) {
       const auto it = peers_.find(peer.id);
       if (it != peers_.end() && it->second.incoming) {
         const PeerMap& p = it->second;
-        const double span = seconds(p.last_slice - p.first_slice);
+        const double span = seconds(p.last_slice - p.requested);
         j["version"] = versionText(p.incoming->announcement().version());
         j["slices_received"] = p.incoming->slicesDone();
         j["slices_total"] = p.incoming->sliceCount();
@@ -375,7 +379,7 @@ void Agent::persist(bool transforms_changed) {
         j["samples_received"] = p.samples;
         j["complete"] = p.features != nullptr;
         j["transfer_seconds"] = span;
-        j["rate_kbps"] = span > 0 ? static_cast<double>(p.bytes - p.first_slice_bytes) * 8 / 1000 / span : 0.0;
+        j["rate_kbps"] = rateKbps(p);
       }
       peers[peer.id] = j;
     }

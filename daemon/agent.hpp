@@ -40,8 +40,9 @@ class Agent {
     std::optional<transport::Reassembler> incoming;  ///< the latest announced version
     std::shared_ptr<const MapFeatures> features;     ///< once complete
     Clock::time_point last_progress{}, last_request{};
+    Clock::time_point requested{};  ///< when this version was first asked for: the transfer's start
     Clock::time_point first_slice{}, last_slice{};
-    size_t first_slice_bytes = 0, bytes = 0, samples = 0;
+    size_t bytes = 0, samples = 0;
   };
   struct Claim {
     std::string claimer;
@@ -64,7 +65,11 @@ class Agent {
   void reject(const std::string& from, const std::string& why);
 
   void pumpSends();
-  void requestMissing();
+  void requestMissing(bool now = false);
+  /// Transfer rate of a peer's map so far [kbit/s]: bytes over the flow-control
+  /// periods they took (the first period's budget leaves at once, so the time
+  /// from the first to the last sample is one period short).
+  double rateKbps(const PeerMap& p) const;
   void claimAndCompute();
   void finishCompute();
   void persist(bool transforms_changed);

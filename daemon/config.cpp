@@ -127,7 +127,7 @@ Config loadConfig(const std::string& path) {
   else if (level == "error") c.log_level = LogLevel::Error;
   else r.fail(*root.get("log_level"), "log_level", "must be debug, info, warning or error");
   c.claim_timeout_s = r.number(root, "claim_timeout_s", 30, 1, 3600);
-  c.request_interval_s = r.number(root, "request_interval_s", 2, 0.1, 600);
+  c.request_interval_s = r.number(root, "request_interval_s", 1, 0.1, 600);
 
   if (const toml::node* peers = root.get("peer")) {
     const toml::array* a = peers->as_array();

@@ -17,7 +17,7 @@ struct Config {
   std::string output_dir;            ///< transforms.json, status.json, cache/
   LogLevel log_level = LogLevel::Info;
   double claim_timeout_s = 30;       ///< a claim without a result is void after this [s]
-  double request_interval_s = 2;     ///< ask again for missing slices after this much silence [s]
+  double request_interval_s = 1;     ///< ask again for missing slices after this much silence [s]
 
   const std::string& agent() const { return transport.agent; }
   bool isPeer(const std::string& id) const;

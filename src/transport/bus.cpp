@@ -9,6 +9,7 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <algorithm>
 #include <stdexcept>
 
 #include "tomomapPubSubTypes.h"
@@ -87,6 +88,13 @@ DataReaderQos readerQos(const TopicQos& t) {
   return q;
 }
 
+/// Slice samples the writer may hold (sent or not, until acknowledged): about
+/// 4 MiB whatever the sample size. Too few stalled slow links (each ack waits
+/// for a heartbeat); the bound keeps memory flat.
+int historySamples(double kbps) {
+  return static_cast<int>(std::clamp<size_t>((4u << 20) / maxSampleBytes(kbps), 256, 4096));
+}
+
 }  // namespace
 
 struct Bus::Impl {
@@ -110,6 +118,10 @@ struct Bus::Impl {
     if (flow_controlled) {
       wq.publish_mode().kind = ASYNCHRONOUS_PUBLISH_MODE;
       wq.publish_mode().flow_controller_name = kFlowControllerName;
+      // Sent samples stay in the bounded history until acknowledged, and acks
+      // follow heartbeats (every 3 s by default): on a slow link the history
+      // filled and the writer stalled until the next one. Ask often.
+      wq.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 100000000);
     }
     DataWriter* w = publisher->create_datawriter(topic, wq);
     if (!w) throw std::runtime_error("cannot create the writer of " + name);
@@ -138,7 +150,7 @@ Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<
     i.announcements = i.addTopic<wire::MapAnnouncementPubSubType, wire::MapAnnouncement>(
         "tomomap/announcements", {true, false, 1, 0, 256}, drop_size(h.announcement));
     i.slices = i.addTopic<wire::SliceFeaturesPubSubType, wire::SliceFeatures>(
-        "tomomap/slices", {false, true, 1, 256, 1},
+        "tomomap/slices", {false, true, 1, historySamples(config.bandwidth_kbps), 1},
         [on = h.slice](wire::SliceFeatures&& s, size_t) {
           const size_t bytes = serializedSize(s);
           if (on) on(std::move(s), bytes);

@@ -24,10 +24,14 @@ size_t bytesPerPeriod(double kbps) {
 }
 
 size_t maxSampleBytes(double kbps) {
-  constexpr size_t kDatagram = 60000;  // below UDP's 64 KiB with RTPS headers
-  const size_t period = bytesPerPeriod(kbps);
-  const size_t samples_per_period = (period + kDatagram - 1) / kDatagram;
-  return std::max<size_t>(1024, period / samples_per_period - 128);  // 128: RTPS headers
+  // The controller sends whole samples only and a sample that does not fit the
+  // rest of a period waits for the next one. Slices vary in size, so with
+  // samples of up to an eighth of the period's budget at most about one
+  // eighth of a period goes unused (one sample per period as at first lost up
+  // to half). And no sample may exceed one UDP datagram.
+  constexpr size_t kDatagram = 60000;
+  constexpr size_t kHeaders = 200;  // RTPS message and submessage headers: the controller counts them
+  return std::clamp<size_t>(bytesPerPeriod(kbps) / 8 - kHeaders, 1024, kDatagram);
 }
 
 namespace {

@@ -36,9 +36,9 @@ extern const char* const kFlowControllerName;
 /// Bytes the flow controller may send per period.
 size_t bytesPerPeriod(double bandwidth_kbps);
 
-/// Largest slice sample: the per-period budget divided evenly into samples
-/// that fit one UDP datagram, so the controller can reach the budget (it sends
-/// only whole samples per period; FASTDDS-NOTES.md).
+/// Largest slice sample: a fraction of the per-period budget, so that the
+/// controller, which sends only whole samples per period (FASTDDS-NOTES.md),
+/// fills each period nearly to the budget.
 size_t maxSampleBytes(double bandwidth_kbps);
 
 /// Creates the participant; throws std::runtime_error naming the cause.
