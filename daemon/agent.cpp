@@ -151,8 +151,13 @@ void Agent::onRequest(wire::ChunkRequest&& r) {
   else
     for (int32_t k : r.slices())
       if (offer_.samples.count(k)) wanted.push_back(k);
-  for (int k : wanted)
+  const auto now = Clock::now();
+  const auto grace = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(config_.request_interval_s));
+  for (int k : wanted) {
+    const auto leaving = leaves_at_.find(k);
+    if (leaving != leaves_at_.end() && now < leaving->second + grace) continue;  // still on its way
     if (queued_.insert(k).second) send_queue_.push_back(k);
+  }
   log_.debug(r.requester().to_string() + " asked for " + std::to_string(wanted.size()) + " slices; " +
              std::to_string(send_queue_.size()) + " queued");
 }
@@ -219,8 +224,14 @@ void Agent::pumpSends() {
     const int k = send_queue_.front();
     const auto& samples = offer_.samples.at(k);
     if (!bus_->publish(samples[next_part_])) return;  // the writer's queue is full: next tick
-    counters_.bytes_sent += transport::Bus::serializedSize(samples[next_part_]);
+    const size_t bytes = transport::Bus::serializedSize(samples[next_part_]);
+    counters_.bytes_sent += bytes;
     ++counters_.samples_sent;
+    const auto now = Clock::now();
+    backlog_until_ = std::max(backlog_until_, now) +
+                     std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                         static_cast<double>(bytes) * 8 / 1000 / config_.transport.bandwidth_kbps));
+    leaves_at_[k] = backlog_until_;
     if (++next_part_ == samples.size()) {
       next_part_ = 0;
       send_queue_.pop_front();
@@ -453,6 +464,12 @@ int Agent::run(const std::atomic<bool>& stop) {
       work.swap(queue_);
     }
     for (auto& w : work) w();
+    {
+      // Decide on claims only with every received event applied: work above
+      // may have taken long (ORB on a received map) while claims arrived.
+      std::lock_guard<std::mutex> lock(queue_mutex_);
+      if (!queue_.empty()) continue;
+    }
     finishCompute();
     pumpSends();
     requestMissing();

@@ -88,6 +88,11 @@ class Agent {
   std::deque<int> send_queue_;  ///< slices to send, in order
   std::set<int> queued_;
   size_t next_part_ = 0;        ///< part of send_queue_.front() to send next
+  /// When the flow controller will have sent everything written so far, and
+  /// when each slice's last copy leaves: a request for a slice still on its way
+  /// is not a reason to send it again.
+  Clock::time_point backlog_until_{};
+  std::map<int, Clock::time_point> leaves_at_;
 
   std::map<std::string, PeerMap> peers_;
   std::map<PairKey, Claim> claims_;

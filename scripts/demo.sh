@@ -1,20 +1,26 @@
 #!/usr/bin/env bash
 # The demo from a fresh Debian 12 machine: installs what is missing, builds,
-# generates an indoor and an outdoor world (no data from outside needed) and
-# matches each pair of maps, printing the transform next to the ground truth.
+# generates a building mapped by three robots (no data from outside needed),
+# runs three tomomapd daemons as separate processes talking Fast DDS over
+# loopback (config/local-3-agents/), shows their progress, prints the agreed
+# transforms next to the ground truth, and stops them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/build.sh >/dev/null
-tomomap=${BUILD_DIR:-build}/src/cli/tomomap
-out=${DEMO_DIR:-$(mktemp -d /tmp/tomomap-demo.XXXXXX)}
-for world in indoor outdoor; do
-  echo "== $world world: generating two overlapping maps (seed 7, low noise)"
-  $tomomap synth --world "$world" --seed 7 --noise low --out "$out/$world" --progress | grep -v '^match with'
-  grid=$(grep -o '"grid": [0-9.]*' "$out/$world/scene.json" | awk '{print $2}')
-  echo "== $world world: matching map_1 (source) into map_0 (target) at grid $grid m"
-  $tomomap match "$out/$world/map_0.pcd" "$out/$world/map_1.pcd" --grid "$grid" \
-    --gt-target "$out/$world/map_0-gtpose.txt" --gt-source "$out/$world/map_1-gtpose.txt" \
-    --json "$out/$world/result.json"
-  echo
+build=${BUILD_DIR:-build}
+out=demo-out
+rm -rf "$out"
+echo "== generating a two-floor building seen by three robots (seed 7, low noise)"
+"$build/src/cli/tomomap" synth --world indoor --maps 3 --seed 7 --noise low --out "$out/world" | grep -v '^match with'
+
+pids=()
+cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
+trap cleanup EXIT
+start=$(date +%s.%N)
+for id in alpha bravo charlie; do
+  mkdir -p "$out/$id"
+  "$build/daemon/tomomapd" --config "config/local-3-agents/$id.toml" 2>"$out/$id.log" &
+  pids+=($!)
 done
-echo "maps and results are in $out"
+echo "== three daemons started (logs: $out/*.log); waiting for every pair to be agreed"
+python3 scripts/demo_watch.py "$out" "$start"
