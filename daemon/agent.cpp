@@ -68,8 +68,11 @@ void Agent::describeOwnMap() {
   offer_ = transport::makeOffer(config_.agent(), *features, raw_bytes,
                                 transport::maxSampleBytes(config_.transport.bandwidth_kbps));
   own_features_ = std::move(features);
+  size_t as_cells = 0;
+  for (const auto& [k, samples] : offer_.samples) as_cells += samples.front().encoding() == wire::SliceEncoding::OCCUPANCY;
   log_.info("map " + config_.map + ": " + std::to_string(filtered.size()) + " cells at g " + fixed(config_.grid, 3) +
-            " m, " + std::to_string(offer_.announcement.slices().size()) + " descriptive slices, " +
+            " m, " + std::to_string(offer_.announcement.slices().size()) + " descriptive slices (" +
+            std::to_string(as_cells) + " sent as occupancy, the rest as features), " +
             std::to_string(own_features_->featureCount()) + " features; version " +
             versionText(offer_.announcement.version()) + "; payload " + std::to_string(offer_.payload_bytes) +
             " bytes = " + fixed(100.0 * static_cast<double>(offer_.payload_bytes) / static_cast<double>(raw_bytes), 1) +
