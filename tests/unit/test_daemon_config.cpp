@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iterator>
 
 #include "config.hpp"
 #include "support.hpp"
@@ -56,4 +57,14 @@ TEST(DaemonConfig, ErrorsNameFileLineAndKey) {
   EXPECT_NE(e.find("c.toml:2:"), std::string::npos) << e;
   e = errorOf(dir, "map = \"a.pcd\"\ndiscovery_port = 17500\n");
   EXPECT_NE(e.find("'agent' is required"), std::string::npos) << e;
+}
+
+TEST(DaemonConfig, EveryKeyIsInTheReference) {
+  std::ifstream in(std::string(TOMOMAP_SOURCE_DIR) + "/docs/configuration.md");
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_FALSE(doc.empty());
+  for (std::string key : configKeys()) {
+    if (key.rfind("peer.", 0) == 0) key = key.substr(5);
+    EXPECT_NE(doc.find("`" + key + "`"), std::string::npos) << key << " is not in docs/configuration.md";
+  }
 }
