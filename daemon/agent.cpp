@@ -132,7 +132,10 @@ void Agent::onSlice(wire::SliceFeatures&& s, size_t bytes) {
   if (p.features) return;  // complete already: a resend meant for another peer
   if (const auto why = p.incoming->accept(s); !why.empty()) return reject(s.agent().to_string(), why);
   const auto now = Clock::now();
-  if (p.samples++ == 0) p.first_slice = now;
+  if (p.samples++ == 0) {
+    p.first_slice = now;
+    persist(false);  // status shows a transfer under way at once, not a second later
+  }
   p.bytes += bytes;
   p.last_slice = p.last_progress = now;
   if (!p.incoming->complete()) return;

@@ -10,8 +10,7 @@ namespace tomomap::transport {
 namespace {
 
 constexpr size_t kFeatureBytes = 4 + 32;  // u, v, descriptor
-constexpr size_t kRunBytes = 6;           // u, v, length
-constexpr size_t kMaxFeaturesPerSample = 4096, kMaxRunsPerSample = 16384;  // the IDL bounds
+constexpr size_t kMaxFeaturesPerSample = 4096, kMaxOccupancyPerSample = 60000;  // the IDL bounds
 constexpr size_t kMaxSlices = 4096;
 
 void put16(std::vector<uint8_t>& b, uint16_t v) {
@@ -28,11 +27,7 @@ std::vector<uint8_t> canonicalBytes(const std::vector<wire::SliceFeatures>& part
       put16(b, f.v());
       b.insert(b.end(), f.descriptor().begin(), f.descriptor().end());
     }
-    for (const auto& r : p.runs()) {
-      put16(b, r.u());
-      put16(b, r.v());
-      put16(b, r.length());
-    }
+    b.insert(b.end(), p.occupancy().begin(), p.occupancy().end());
   }
   return b;
 }
@@ -41,23 +36,38 @@ uint32_t crcOf(const std::vector<uint8_t>& bytes) {
   return static_cast<uint32_t>(crc32(crc32(0L, Z_NULL, 0), bytes.data(), static_cast<uInt>(bytes.size())));
 }
 
-/// Occupied cells of one slice as runs along raster rows.
-std::vector<wire::CellRun> toRuns(const std::vector<uint32_t>& cells, int width) {
-  std::vector<wire::CellRun> runs;
-  const auto w = static_cast<uint32_t>(width);
-  for (size_t i = 0; i < cells.size();) {
-    size_t j = i + 1;
-    while (j < cells.size() && cells[j] == cells[j - 1] + 1 && cells[j] / w == cells[i] / w &&
-           j - i < 0xffff)
-      ++j;
-    wire::CellRun r;
-    r.u(static_cast<uint16_t>(cells[i] % w));
-    r.v(static_cast<uint16_t>(cells[i] / w));
-    r.length(static_cast<uint16_t>(j - i));
-    runs.push_back(r);
-    i = j;
-  }
-  return runs;
+size_t rasterBytes(size_t width, size_t height) { return (width * height + 7) / 8; }
+
+/// A slice's occupied cells as a bit raster, deflated (zlib, best compression).
+/// Walls are long runs of set bits or one bit repeated row after row, which
+/// deflate stores in a few bytes where a list of cells would take 4 each.
+std::vector<uint8_t> deflateCells(const std::vector<uint32_t>& cells, int width, int height) {
+  std::vector<uint8_t> raster(rasterBytes(static_cast<size_t>(width), static_cast<size_t>(height)), 0);
+  for (uint32_t c : cells) raster[c / 8] = static_cast<uint8_t>(raster[c / 8] | (1u << (c % 8)));
+  uLongf size = compressBound(static_cast<uLong>(raster.size()));
+  std::vector<uint8_t> out(size);
+  if (compress2(out.data(), &size, raster.data(), static_cast<uLong>(raster.size()), Z_BEST_COMPRESSION) != Z_OK)
+    return {};
+  out.resize(size);
+  return out;
+}
+
+/// The inverse; nullopt when the bytes do not inflate to exactly the raster.
+std::optional<std::vector<uint32_t>> inflateCells(const std::vector<uint8_t>& bytes, int width, int height) {
+  std::vector<uint8_t> raster(rasterBytes(static_cast<size_t>(width), static_cast<size_t>(height)));
+  uLongf size = static_cast<uLongf>(raster.size());
+  if (uncompress(raster.data(), &size, bytes.data(), static_cast<uLong>(bytes.size())) != Z_OK ||
+      size != raster.size())
+    return std::nullopt;
+  std::vector<uint32_t> cells;
+  const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
+  for (size_t i = 0; i < raster.size(); ++i)
+    for (uint32_t bit = 0; raster[i] >> bit; ++bit)
+      if ((raster[i] >> bit) & 1u) {
+        if (8 * i + bit >= n) return std::nullopt;  // bits past the raster's end
+        cells.push_back(static_cast<uint32_t>(8 * i + bit));
+      }
+  return cells;
 }
 
 template <typename T>
@@ -79,7 +89,7 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, uint64_t raw_
   const size_t room = max_sample_bytes > sampleOverhead() + kFeatureBytes ? max_sample_bytes - sampleOverhead()
                                                                            : kFeatureBytes;
   const size_t features_per_part = std::clamp<size_t>(room / kFeatureBytes, 1, kMaxFeaturesPerSample);
-  const size_t runs_per_part = std::clamp<size_t>(room / kRunBytes, 1, kMaxRunsPerSample);
+  const size_t bytes_per_part = std::clamp<size_t>(room, 1, kMaxOccupancyPerSample);
 
   MapOffer offer;
   auto& a = offer.announcement;
@@ -114,8 +124,8 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, uint64_t raw_
       feats.push_back(w);
     }
     const auto& cells = f.occupancy.cells.at(static_cast<size_t>(s->index));
-    std::vector<wire::CellRun> runs = toRuns(cells, g.width);
-    const bool as_cells = !cells.empty() && runs.size() * kRunBytes < feats.size() * kFeatureBytes;
+    const std::vector<uint8_t> deflated = cells.empty() ? std::vector<uint8_t>{} : deflateCells(cells, g.width, g.height);
+    const bool as_cells = !deflated.empty() && deflated.size() < feats.size() * kFeatureBytes;
 
     std::vector<wire::SliceFeatures> samples;
     auto base = [&](size_t part, size_t parts) {
@@ -128,8 +138,9 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, uint64_t raw_
       return x;
     };
     if (as_cells) {
-      const auto parts = split(runs, runs_per_part);
-      for (size_t p = 0; p < parts.size(); ++p) samples.push_back(base(p, parts.size())), samples.back().runs(parts[p]);
+      const auto parts = split(deflated, bytes_per_part);
+      for (size_t p = 0; p < parts.size(); ++p)
+        samples.push_back(base(p, parts.size())), samples.back().occupancy(parts[p]);
     } else {
       const auto parts = split(feats, features_per_part);
       for (size_t p = 0; p < parts.size(); ++p)
@@ -186,8 +197,9 @@ Rejection validate(const wire::MapAnnouncement& a) {
     if (e.slice() < 0 || e.slice() >= a.slice_count() || !seen.insert(e.slice()).second)
       return "announcement lists slice " + std::to_string(e.slice()) + " out of range or twice";
     if (e.parts() == 0 || e.parts() > 1024) return "announcement with a bad part count";
-    // A slice can never need more than its raster in runs or ORB's cap in features.
-    const size_t cap = std::max<size_t>(size_t{a.width()} * a.height() * kRunBytes, 100000 * kFeatureBytes);
+    // A slice can never need more than its deflated raster or ORB's cap in features.
+    const size_t cap = std::max<size_t>(compressBound(static_cast<uLong>(rasterBytes(a.width(), a.height()))),
+                                        100000 * kFeatureBytes);
     if (e.bytes() > cap) return "announcement with an oversized slice";
   }
   if (a.version() != mapVersion(a)) return "announcement whose version does not match its content";
@@ -204,10 +216,7 @@ Rejection Reassembler::accept(const wire::SliceFeatures& x) {
   const wire::SliceEntry& e = announcement_.slices()[it->second];
   if (x.parts() != e.parts() || x.part() >= e.parts()) return "part numbering differs from the announcement";
   const bool cells = x.encoding() == wire::SliceEncoding::OCCUPANCY;
-  if ((cells && !x.features().empty()) || (!cells && !x.runs().empty())) return "sample mixes encodings";
-  for (const auto& r : x.runs())
-    if (r.length() == 0 || size_t{r.u()} + r.length() > announcement_.width() || r.v() >= announcement_.height())
-      return "cell run outside the raster";
+  if ((cells && !x.features().empty()) || (!cells && !x.occupancy().empty())) return "sample mixes encodings";
   for (const auto& f : x.features())
     if (f.u() >= announcement_.width() || f.v() >= announcement_.height()) return "keypoint outside the raster";
   if (done_.count(x.slice())) return {};  // a duplicate of a verified slice
@@ -216,10 +225,10 @@ Rejection Reassembler::accept(const wire::SliceFeatures& x) {
   p.parts.resize(e.parts());
   auto& slot = p.parts[x.part()];
   if (slot) return {};  // duplicate part
-  const size_t bytes = x.features().size() * kFeatureBytes + x.runs().size() * kRunBytes;
+  const size_t bytes = x.features().size() * kFeatureBytes + x.occupancy().size();
   size_t held = 0;
   for (const auto& q : p.parts)
-    if (q) held += q->features().size() * kFeatureBytes + q->runs().size() * kRunBytes;
+    if (q) held += q->features().size() * kFeatureBytes + q->occupancy().size();
   if (held + bytes > e.bytes()) {
     partial_.erase(x.slice());
     return "slice larger than announced";
@@ -234,6 +243,11 @@ Rejection Reassembler::accept(const wire::SliceFeatures& x) {
   partial_.erase(x.slice());
   const auto canonical = canonicalBytes(parts);
   if (canonical.size() != e.bytes() || crcOf(canonical) != e.crc32()) return "slice checksum mismatch";
+  if (parts.front().encoding() == wire::SliceEncoding::OCCUPANCY) {
+    auto decoded = inflateCells(canonical, announcement_.width(), announcement_.height());
+    if (!decoded) return "occupancy does not inflate to the announced raster";
+    cells_[x.slice()] = std::move(*decoded);
+  }
   done_[x.slice()] = std::move(parts);
   return {};
 }
@@ -253,12 +267,7 @@ MapFeatures Reassembler::build(const FeatureParams& params) const {
   std::vector<SliceFeatures> sent_as_features;
   for (const auto& [index, parts] : done_) {
     if (parts.front().encoding() == wire::SliceEncoding::OCCUPANCY) {
-      auto& cells = stack.cells[static_cast<size_t>(index)];
-      for (const auto& p : parts)
-        for (const auto& r : p.runs())
-          for (uint32_t k = 0; k < r.length(); ++k) cells.push_back(uint32_t{r.v()} * a.width() + r.u() + k);
-      std::sort(cells.begin(), cells.end());
-      cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+      stack.cells[static_cast<size_t>(index)] = cells_.at(index);
     } else {
       SliceFeatures s;
       s.index = index;

@@ -70,6 +70,7 @@ class Reassembler {
   std::map<int, size_t> entries_;  ///< slice index -> position in the announcement
   std::map<int, Partial> partial_;
   std::map<int, std::vector<wire::SliceFeatures>> done_;
+  std::map<int, std::vector<uint32_t>> cells_;  ///< inflated occupancy of verified slices
   size_t bytes_received_ = 0;
 };
 

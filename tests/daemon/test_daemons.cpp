@@ -102,9 +102,9 @@ TEST(Daemons, AReceiverKilledMidTransferCompletesAfterRestart) {
   TempDir dir;
   Fleet fleet(dir);
   const std::string d = demoRoom() + "/";
-  // 200 kbit/s: about 5 s for the ~120 kB of features, time to kill mid-way.
-  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd", 0.05, 200},
-                                      {"bravo", d + "demo-pcd2.pcd", 0.05, 200}};
+  // 64 kbit/s, the lowest budget: about 3 s for the ~21-25 kB of slices, time to kill mid-way.
+  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd", 0.05, 64},
+                                      {"bravo", d + "demo-pcd2.pcd", 0.05, 64}};
   for (const auto& a : agents) fleet.start(a, agents);
   const auto until = std::chrono::steady_clock::now() + 20s;
   int received = 0;

@@ -89,23 +89,15 @@ TEST(SliceCodec, InconsistentSamplesAreRejectedNotCrashed) {
   wire::SliceFeatures parts = s;
   parts.parts(static_cast<uint16_t>(parts.parts() + 1));
   EXPECT_NE(r.accept(parts), "");
-  wire::SliceFeatures outside = s;
-  wire::CellRun run;
-  run.u(65000);
-  run.v(1);
-  run.length(10);
-  outside.encoding(wire::SliceEncoding::OCCUPANCY);
-  outside.features({});
-  outside.runs({run});
-  EXPECT_NE(r.accept(outside), "");
+  wire::SliceFeatures mixed = s;
+  mixed.features().resize(1);
+  mixed.occupancy({1, 2, 3});
+  EXPECT_NE(r.accept(mixed), "");
 
   // A corrupted payload is caught by the CRC once the slice is whole.
   wire::SliceFeatures corrupt = s;
   if (!corrupt.features().empty()) corrupt.features()[0].descriptor()[0] ^= 0xff;
-  if (!corrupt.runs().empty()) {
-    auto& r0 = corrupt.runs()[0];
-    r0.u(static_cast<uint16_t>(r0.u() > 0 ? r0.u() - 1 : r0.u() + 1));  // same size, other cells
-  }
+  if (!corrupt.occupancy().empty()) corrupt.occupancy()[corrupt.occupancy().size() / 2] ^= 0x5a;
   std::string verdict;
   for (uint16_t p = 0; p < s.parts(); ++p) {
     wire::SliceFeatures x = p == s.part() ? corrupt : offer.samples.begin()->second[p];
