@@ -9,7 +9,6 @@
 
 #include "core/map_io.hpp"
 #include "core/matcher.hpp"
-#include "core/voxel_filter.hpp"
 #include "state_files.hpp"
 
 namespace tomomap::daemon {
@@ -58,19 +57,22 @@ void Agent::post(std::function<void()> work) {
 
 void Agent::describeOwnMap() {
   const auto t0 = Clock::now();
-  Points map = loadMap(config_.map);
-  validateMap(map, config_.map);
-  const Points filtered = voxelFilter(map, config_.grid);
-  Points().swap(map);
-  const uint64_t raw_bytes = 12 * filtered.size() + kPcdHeaderBytes;
-  auto features = std::make_shared<MapFeatures>(extractFeatures(makeSlices(filtered, config_.grid)));
+  size_t cells = 0;
+  auto features = [&] {
+    const Points map = loadMap(config_.map);  // dropped once described
+    validateMap(map, config_.map);
+    MatchParams params;
+    params.grid = config_.grid;
+    return std::make_shared<MapFeatures>(describeMap(map, params, nullptr, &cells));
+  }();
+  const uint64_t raw_bytes = 12 * cells + kPcdHeaderBytes;
   const double extract_s = seconds(Clock::now() - t0);
   offer_ = transport::makeOffer(config_.agent(), *features, raw_bytes,
                                 transport::maxSampleBytes(config_.transport.bandwidth_kbps));
   own_features_ = std::move(features);
   size_t as_cells = 0;
   for (const auto& [k, samples] : offer_.samples) as_cells += samples.front().encoding() == wire::SliceEncoding::OCCUPANCY;
-  log_.info("map " + config_.map + ": " + std::to_string(filtered.size()) + " cells at g " + fixed(config_.grid, 3) +
+  log_.info("map " + config_.map + ": " + std::to_string(cells) + " cells at g " + fixed(config_.grid, 3) +
             " m, " + std::to_string(offer_.announcement.slices().size()) + " descriptive slices (" +
             std::to_string(as_cells) + " sent as occupancy, the rest as features), " +
             std::to_string(own_features_->featureCount()) + " features; version " +

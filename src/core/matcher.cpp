@@ -57,12 +57,14 @@ Correspondences matchSlices(const SliceFeatures& target, const SliceFeatures& so
   return c;
 }
 
-MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings) {
+MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings,
+                        size_t* filtered_points) {
   StageTimings local;
   StageTimings& t = timings ? *timings : local;
   auto t0 = Clock::now();
   const Points filtered = voxelFilter(map, params.grid);
   t.voxel += secondsSince(t0);
+  if (filtered_points) *filtered_points = filtered.size();
   t0 = Clock::now();
   SliceStack stack = makeSlices(filtered, params.grid);
   t.slicing += secondsSince(t0);

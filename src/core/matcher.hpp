@@ -76,7 +76,9 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source,
 MatchResult matchMaps(const Points& target, const Points& source, const MatchParams& params,
                       const Progress& progress = {});
 
-/// Voxel filter, slicing and features of one map, with the time each took.
-MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings = nullptr);
+/// Voxel filter, slicing and features of one map, with the time each took and
+/// (if asked) how many points the voxel filter kept.
+MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings = nullptr,
+                        size_t* filtered_points = nullptr);
 
 }  // namespace tomomap

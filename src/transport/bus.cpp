@@ -24,16 +24,16 @@ namespace {
 template <typename T>
 class Listener : public DataReaderListener {
  public:
-  explicit Listener(std::function<void(T&&, size_t)> on) : on_(std::move(on)) {}
+  explicit Listener(std::function<void(T&&)> on) : on_(std::move(on)) {}
   void on_data_available(DataReader* reader) override {
     T sample;
     SampleInfo info;
     while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK)
-      if (info.valid_data && on_) on_(std::move(sample), 0);
+      if (info.valid_data && on_) on_(std::move(sample));
   }
 
  private:
-  std::function<void(T&&, size_t)> on_;
+  std::function<void(T&&)> on_;
 };
 
 class ParticipantWatch : public DomainParticipantListener {
@@ -60,31 +60,24 @@ struct TopicQos {
   int max_instances = 1024;
 };
 
-DataWriterQos writerQos(const TopicQos& t) {
-  DataWriterQos q = DATAWRITER_QOS_DEFAULT;
+/// What writer and reader of a topic agree on: reliable, durability, history
+/// and its limits, and samples allocated at their real size (not the IDL bound).
+template <typename EndpointQos>
+EndpointQos endpointQos(EndpointQos q, const TopicQos& t) {
   q.reliability().kind = RELIABLE_RELIABILITY_QOS;
-  q.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(0, 200000000);
   q.durability().kind = t.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
   q.history().kind = t.keep_all ? KEEP_ALL_HISTORY_QOS : KEEP_LAST_HISTORY_QOS;
   q.history().depth = t.depth;
   q.resource_limits().max_instances = t.max_instances;
   q.resource_limits().max_samples_per_instance = t.keep_all ? t.max_samples : t.depth;
   q.resource_limits().max_samples = t.keep_all ? t.max_samples : t.max_instances * t.depth;
-  // Samples are allocated at their real size, not at the IDL bound.
   q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
   return q;
 }
 
-DataReaderQos readerQos(const TopicQos& t) {
-  DataReaderQos q = DATAREADER_QOS_DEFAULT;
-  q.reliability().kind = RELIABLE_RELIABILITY_QOS;
-  q.durability().kind = t.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
-  q.history().kind = t.keep_all ? KEEP_ALL_HISTORY_QOS : KEEP_LAST_HISTORY_QOS;
-  q.history().depth = t.depth;
-  q.resource_limits().max_instances = t.max_instances;
-  q.resource_limits().max_samples_per_instance = t.keep_all ? t.max_samples : t.depth;
-  q.resource_limits().max_samples = t.keep_all ? t.max_samples : t.max_instances * t.depth;
-  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+DataWriterQos writerQos(const TopicQos& t) {
+  DataWriterQos q = endpointQos(DATAWRITER_QOS_DEFAULT, t);
+  q.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(0, 200000000);
   return q;
 }
 
@@ -107,7 +100,7 @@ struct Bus::Impl {
              *estimates = nullptr;
 
   template <typename PubSub, typename T>
-  DataWriter* addTopic(const std::string& name, const TopicQos& tq, std::function<void(T&&, size_t)> on,
+  DataWriter* addTopic(const std::string& name, const TopicQos& tq, std::function<void(T&&)> on,
                        bool flow_controlled = false) {
     TypeSupport type(new PubSub());
     if (type.register_type(participant) != ReturnCode_t::RETCODE_OK)
@@ -126,7 +119,7 @@ struct Bus::Impl {
     DataWriter* w = publisher->create_datawriter(topic, wq);
     if (!w) throw std::runtime_error("cannot create the writer of " + name);
     listeners.push_back(std::make_unique<Listener<T>>(std::move(on)));
-    if (!subscriber->create_datareader(topic, readerQos(tq), listeners.back().get()))
+    if (!subscriber->create_datareader(topic, endpointQos(DATAREADER_QOS_DEFAULT, tq), listeners.back().get()))
       throw std::runtime_error("cannot create the reader of " + name);
     return w;
   }
@@ -141,27 +134,22 @@ Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<
     i.publisher = i.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
     i.subscriber = i.participant->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
     if (!i.publisher || !i.subscriber) throw std::runtime_error("cannot create publisher/subscriber");
-    auto drop_size = [](auto f) {
-      return [f](auto&& x, size_t) {
-        if (f) f(std::move(x));
-      };
-    };
     // Announcements and estimates: one per agent / pair, kept for late joiners.
     i.announcements = i.addTopic<wire::MapAnnouncementPubSubType, wire::MapAnnouncement>(
-        "tomomap/announcements", {true, false, 1, 0, 256}, drop_size(h.announcement));
+        "tomomap/announcements", {true, false, 1, 0, 256}, h.announcement);
     i.slices = i.addTopic<wire::SliceFeaturesPubSubType, wire::SliceFeatures>(
         "tomomap/slices", {false, true, 1, historySamples(config.bandwidth_kbps), 1},
-        [on = h.slice](wire::SliceFeatures&& s, size_t) {
+        [on = h.slice](wire::SliceFeatures&& s) {
           const size_t bytes = serializedSize(s);
           if (on) on(std::move(s), bytes);
         },
         /*flow_controlled=*/true);
     i.requests = i.addTopic<wire::ChunkRequestPubSubType, wire::ChunkRequest>(
-        "tomomap/requests", {false, true, 1, 256, 1}, drop_size(h.request));
+        "tomomap/requests", {false, true, 1, 256, 1}, h.request);
     i.claims = i.addTopic<wire::MatchClaimPubSubType, wire::MatchClaim>("tomomap/claims", {false, false, 1, 0, 1024},
-                                                                       drop_size(h.claim));
+                                                                       h.claim);
     i.estimates = i.addTopic<wire::TransformEstimatePubSubType, wire::TransformEstimate>(
-        "tomomap/estimates", {true, false, 1, 0, 1024}, drop_size(h.estimate));
+        "tomomap/estimates", {true, false, 1, 0, 1024}, h.estimate);
   } catch (...) {
     i.participant->delete_contained_entities();
     DomainParticipantFactory::get_instance()->delete_participant(i.participant);

@@ -12,6 +12,9 @@ namespace {
 constexpr size_t kFeatureBytes = 4 + 32;  // u, v, descriptor
 constexpr size_t kMaxFeaturesPerSample = 4096, kMaxOccupancyPerSample = 60000;  // the IDL bounds
 constexpr size_t kMaxSlices = 4096;
+/// Room a sample's own fields take besides its payload (agent, version, slice,
+/// part numbers, encoding, sequence lengths), with margin.
+constexpr size_t kSampleHeaderBytes = 256;
 
 void put16(std::vector<uint8_t>& b, uint16_t v) {
   b.push_back(static_cast<uint8_t>(v & 0xff));
@@ -82,12 +85,10 @@ std::vector<std::vector<T>> split(const std::vector<T>& items, size_t per_part) 
 
 }  // namespace
 
-size_t sampleOverhead() { return 256; }
-
 MapOffer makeOffer(const std::string& agent, const MapFeatures& f, uint64_t raw_bytes, size_t max_sample_bytes) {
   const SliceGrid& g = f.occupancy.grid;
-  const size_t room = max_sample_bytes > sampleOverhead() + kFeatureBytes ? max_sample_bytes - sampleOverhead()
-                                                                           : kFeatureBytes;
+  const size_t room =
+      max_sample_bytes > kSampleHeaderBytes + kFeatureBytes ? max_sample_bytes - kSampleHeaderBytes : kFeatureBytes;
   const size_t features_per_part = std::clamp<size_t>(room / kFeatureBytes, 1, kMaxFeaturesPerSample);
   const size_t bytes_per_part = std::clamp<size_t>(room, 1, kMaxOccupancyPerSample);
 

@@ -20,10 +20,6 @@ struct MapOffer {
   size_t payload_bytes = 0;  ///< sum of the slices' payload bytes
 };
 
-/// Serialised size of one sample of `payload` bytes, header included (what the
-/// flow controller counts, within a few bytes).
-size_t sampleOverhead();
-
 /// Slices `features` (its occupancy must be present) into samples of at most
 /// `max_sample_bytes` each. `raw_bytes` is the binary PCD size of the
 /// voxel-filtered map, announced for the record. Most informative slices
