@@ -260,6 +260,29 @@ std::vector<int32_t> Reassembler::missing() const {
   return out;
 }
 
+size_t Reassembler::adopt(const Reassembler& earlier) {
+  const auto& a = announcement_;
+  const auto& b = earlier.announcement_;
+  const bool same_raster = a.agent() == b.agent() && a.grid() == b.grid() && a.x_min() == b.x_min() &&
+                           a.y_min() == b.y_min() && a.z_min() == b.z_min() && a.width() == b.width() &&
+                           a.height() == b.height();
+  if (!same_raster) return 0;  // every cell index means something else now
+  size_t taken = 0;
+  for (const auto& [index, position] : entries_) {
+    const auto old = earlier.entries_.find(index);
+    const auto parts = earlier.done_.find(index);
+    if (done_.count(index) || old == earlier.entries_.end() || parts == earlier.done_.end()) continue;
+    const wire::SliceEntry& now = a.slices()[position];
+    const wire::SliceEntry& then = b.slices()[old->second];
+    if (now.crc32() != then.crc32() || now.bytes() != then.bytes() || now.parts() != then.parts()) continue;
+    done_[index] = parts->second;
+    if (const auto cells = earlier.cells_.find(index); cells != earlier.cells_.end()) cells_[index] = cells->second;
+    partial_.erase(index);
+    ++taken;
+  }
+  return taken;
+}
+
 MapFeatures Reassembler::build(const FeatureParams& params) const {
   const auto& a = announcement_;
   SliceStack stack;

@@ -56,6 +56,11 @@ class Reassembler {
   /// The map's features, as the owner computed them (ORB is run here on slices
   /// that came as occupancy). Only when complete().
   MapFeatures build(const FeatureParams& params) const;
+  /// Takes over the verified slices of an earlier version of the same agent's
+  /// map that this version announces unchanged (same raster, same index, size
+  /// and CRC), so that a map update costs only the slices that changed.
+  /// Returns how many were taken.
+  size_t adopt(const Reassembler& earlier);
 
  private:
   struct Partial {

@@ -15,17 +15,26 @@ using namespace tomomap::transport;
 
 namespace {
 
-/// A small generated map described at g = 0.1.
-const MapFeatures& sampleMap() {
-  static const MapFeatures f = [] {
+/// A small generated map.
+const Points& samplePoints() {
+  static const Points points = [] {
     synth::SceneParams sp;
     sp.scale = 0.5;
     const synth::Scene scene = synth::makeScene(sp);
-    const Points map = synth::scanScene(scene, synth::noiseLevel("low"), 1).front().points;
-    MatchParams p;
-    p.grid = 0.1;
-    return describeMap(map, p);
+    return synth::scanScene(scene, synth::noiseLevel("low"), 1).front().points;
   }();
+  return points;
+}
+
+MapFeatures describeAtDecimetre(const Points& map) {
+  MatchParams p;
+  p.grid = 0.1;
+  return describeMap(map, p);
+}
+
+/// The sample map described at g = 0.1.
+const MapFeatures& sampleMap() {
+  static const MapFeatures f = describeAtDecimetre(samplePoints());
   return f;
 }
 
@@ -117,4 +126,41 @@ TEST(SliceCodec, InconsistentSamplesAreRejectedNotCrashed) {
   a = offer.announcement;
   a.version(a.version() + 1);
   EXPECT_NE(validate(a), "");
+}
+
+TEST(SliceCodec, AMapUpdateReusesTheSlicesThatDidNotChange) {
+  // The robot's map gains a cabinet between 0.5 and 1.2 m, inside its bounds.
+  Points updated = samplePoints();
+  Eigen::Vector3f lo = updated.front(), hi = updated.front();
+  for (const auto& p : updated) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const Eigen::Vector3f centre = (lo + hi) / 2;
+  for (float x = -0.6f; x <= 0.6f; x += 0.02f)
+    for (float z = 0.5f; z <= 1.2f; z += 0.02f) {
+      updated.emplace_back(centre.x() + x, centre.y() - 0.4f, lo.z() + z);
+      updated.emplace_back(centre.x() + x, centre.y() + 0.4f, lo.z() + z);
+    }
+  const MapOffer before = makeOffer("alpha", sampleMap(), 1000000, 4000);
+  const MapFeatures changed = describeAtDecimetre(updated);
+  const MapOffer after = makeOffer("alpha", changed, 1000000, 4000);
+  ASSERT_NE(before.announcement.version(), after.announcement.version());
+
+  const Reassembler old = receiveAll(before, false);
+  Reassembler next(after.announcement);
+  const size_t taken = next.adopt(old);
+  EXPECT_GT(taken, after.announcement.slices().size() / 2) << "most slices did not change";
+  const auto missing = next.missing();
+  ASSERT_FALSE(missing.empty()) << "the slices with the cabinet changed";
+  for (int32_t k : missing)
+    for (const auto& s : after.samples.at(k)) EXPECT_EQ(next.accept(s), "");
+  ASSERT_TRUE(next.complete());
+  const MapFeatures back = next.build({});
+  ASSERT_EQ(back.slices.size(), changed.slices.size());
+  for (size_t i = 0; i < back.slices.size(); ++i)
+    EXPECT_EQ(cv::norm(back.slices[i].descriptors, changed.slices[i].descriptors, cv::NORM_HAMMING), 0);
+
+  // Another agent's slices, or a different raster, are never taken.
+  wire::MapAnnouncement other = after.announcement;
+  other.agent("bravo");
+  Reassembler stranger(other);
+  EXPECT_EQ(stranger.adopt(old), 0u);
 }
