@@ -9,35 +9,16 @@
 
 #include "core/map_io.hpp"
 #include "core/matcher.hpp"
+#include "agent_detail.hpp"
 #include "state_files.hpp"
 
 namespace tomomap::daemon {
+using namespace detail;
+
 namespace {
 
-namespace fs = std::filesystem;
-
-constexpr auto kTick = std::chrono::milliseconds(50);
-constexpr auto kClaimSettle = std::chrono::milliseconds(500);  ///< time for competing claims to show up
-constexpr auto kReannounce = std::chrono::seconds(5);
-constexpr auto kStatusEvery = std::chrono::seconds(1);
 constexpr size_t kPcdHeaderBytes = 190;  ///< a binary PCD header for x y z float
-
-double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
-
-uint64_t wallMs() {
-  return static_cast<uint64_t>(
-      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
-          .count());
-}
-
-std::string fixed(double v, int digits) {
-  std::ostringstream o;
-  o << std::fixed << std::setprecision(digits) << v;
-  return o.str();
-}
-
-
-std::string pairText(const PairKey& p) { return p.first + "<-" + p.second; }
+constexpr auto kClaimSettle = std::chrono::milliseconds(500);  ///< time for competing claims to show up
 
 }  // namespace
 
@@ -55,31 +36,60 @@ void Agent::post(std::function<void()> work) {
   queue_cv_.notify_one();
 }
 
-void Agent::describeOwnMap() {
+OwnMap describeOwnMap(const Config& config) {
   const auto t0 = Clock::now();
-  size_t cells = 0;
+  OwnMap own;
   auto features = [&] {
-    const Points map = loadMap(config_.map);  // dropped once described
-    validateMap(map, config_.map);
+    const Points map = loadMap(config.map);  // dropped once described
+    validateMap(map, config.map);
     MatchParams params;
-    params.grid = config_.grid;
-    return std::make_shared<MapFeatures>(describeMap(map, params, nullptr, &cells));
+    params.grid = config.grid;
+    return std::make_shared<MapFeatures>(describeMap(map, params, nullptr, &own.cells));
   }();
-  const uint64_t raw_bytes = 12 * cells + kPcdHeaderBytes;
-  const double extract_s = seconds(Clock::now() - t0);
-  offer_ = transport::makeOffer(config_.agent(), *features, raw_bytes,
-                                transport::maxSampleBytes(config_.transport.bandwidth_kbps));
-  own_features_ = std::move(features);
+  const uint64_t raw_bytes = 12 * own.cells + kPcdHeaderBytes;
+  own.offer = transport::makeOffer(config.agent(), *features, raw_bytes,
+                                   transport::maxSampleBytes(config.transport.bandwidth_kbps));
+  own.features = std::move(features);
+  own.seconds = seconds(Clock::now() - t0);
+  return own;
+}
+
+void Agent::installOwnMap(OwnMap own) {
+  const bool update = own_features_ != nullptr;
+  const uint64_t before = offer_.announcement.version();
+  offer_ = std::move(own.offer);
+  own_features_ = std::move(own.features);
+  map_updated_ms_ = wallMs();
+  // Queued parts belong to the old version: peers ask again for what they need.
+  send_queue_.clear();
+  queued_.clear();
+  next_part_ = 0;
+  leaves_at_.clear();
+  for (auto it = own_claims_.begin(); it != own_claims_.end();)  // claimed with the old version
+    it = (it->first.first == config_.agent() || it->first.second == config_.agent()) ? own_claims_.erase(it)
+                                                                                     : std::next(it);
   size_t as_cells = 0;
   for (const auto& [k, samples] : offer_.samples) as_cells += samples.front().encoding() == wire::SliceEncoding::OCCUPANCY;
-  log_.info("map " + config_.map + ": " + std::to_string(cells) + " cells at g " + fixed(config_.grid, 3) +
-            " m, " + std::to_string(offer_.announcement.slices().size()) + " descriptive slices (" +
-            std::to_string(as_cells) + " sent as occupancy, the rest as features), " +
-            std::to_string(own_features_->featureCount()) + " features; version " +
-            versionText(offer_.announcement.version()) + "; payload " + std::to_string(offer_.payload_bytes) +
-            " bytes = " + fixed(100.0 * static_cast<double>(offer_.payload_bytes) / static_cast<double>(raw_bytes), 1) +
-            " % of the voxel-filtered map's binary PCD (" + std::to_string(raw_bytes) + " bytes); described in " +
-            fixed(extract_s, 2) + " s");
+  const auto& a = offer_.announcement;
+  log_.info(std::string(update ? "map updated: " : "map ") + config_.map + ": " + std::to_string(own.cells) +
+            " cells at g " + fixed(config_.grid, 3) + " m, " + std::to_string(a.slices().size()) +
+            " descriptive slices (" + std::to_string(as_cells) + " sent as occupancy, the rest as features), " +
+            std::to_string(own_features_->featureCount()) + " features; version " + versionText(a.version()) +
+            (update ? " (was " + versionText(before) + ")" : "") + "; payload " + std::to_string(offer_.payload_bytes) +
+            " bytes = " +
+            fixed(100.0 * static_cast<double>(offer_.payload_bytes) / static_cast<double>(a.raw_bytes()), 1) +
+            " % of the voxel-filtered map's binary PCD (" + std::to_string(a.raw_bytes()) + " bytes); described in " +
+            fixed(own.seconds, 2) + " s");
+  if (bus_) {
+    bus_->publish(offer_.announcement);
+    persist(false);
+  }
+}
+
+bool Agent::fromKnown(const std::string& sender, const char* what) {
+  if (!known(sender, what)) return false;
+  if (sender != config_.agent()) last_seen_ms_[sender] = wallMs();
+  return true;
 }
 
 bool Agent::known(const std::string& agent, const char* what) {
@@ -108,25 +118,34 @@ std::shared_ptr<const MapFeatures> Agent::featuresOf(const std::string& agent) c
 }
 
 void Agent::onAnnouncement(wire::MapAnnouncement&& a) {
-  if (a.agent().to_string() == config_.agent() || !known(a.agent().to_string(), "an announcement")) return;
+  if (a.agent().to_string() == config_.agent() || !fromKnown(a.agent().to_string(), "an announcement")) return;
   if (const auto why = transport::validate(a); !why.empty()) return reject(a.agent().to_string(), why);
-  PeerMap& p = peers_[a.agent().to_string()];
+  const std::string owner = a.agent().to_string();
+  PeerMap& p = peers_[owner];
   if (p.incoming && p.incoming->announcement().version() == a.version()) return;  // already known
-  log_.info("peer " + a.agent().to_string() + " announced map version " + versionText(a.version()) + ": " +
-            std::to_string(a.slices().size()) + " slices");
+  std::optional<transport::Reassembler> earlier = std::move(p.incoming);
   p = PeerMap{};
   p.incoming.emplace(std::move(a));
-  p.last_progress = Clock::now();
-  wire::ChunkRequest r;  // first contact: everything (an empty list)
+  // A new version of a map we hold (or held in part): keep the unchanged slices.
+  if (earlier) p.reused = p.incoming->adopt(*earlier);
+  const auto& announced = p.incoming->announcement();
+  log_.info("peer " + owner + " announced map version " + versionText(announced.version()) + ": " +
+            std::to_string(announced.slices().size()) + " slices" +
+            (earlier ? ", " + std::to_string(p.reused) + " of them unchanged from version " +
+                           versionText(earlier->announcement().version())
+                     : ""));
+  p.last_progress = p.requested = p.last_request = Clock::now();
+  if (p.incoming->complete()) return completeTransfer(owner, p);
+  wire::ChunkRequest r;
   r.requester(config_.agent());
-  r.owner(p.incoming->announcement().agent().to_string());
-  r.version(p.incoming->announcement().version());
+  r.owner(owner);
+  r.version(announced.version());
+  if (p.reused > 0) r.slices(p.incoming->missing());  // else an empty list: everything
   bus_->publish(r);
-  p.last_request = p.requested = Clock::now();
 }
 
 void Agent::onSlice(wire::SliceFeatures&& s, size_t bytes) {
-  if (s.agent().to_string() == config_.agent() || !known(s.agent().to_string(), "a slice")) return;
+  if (s.agent().to_string() == config_.agent() || !fromKnown(s.agent().to_string(), "a slice")) return;
   const auto it = peers_.find(s.agent().to_string());
   if (it == peers_.end() || !it->second.incoming || it->second.incoming->announcement().version() != s.version())
     return;  // a version we were not told about (yet) or no longer want
@@ -140,18 +159,25 @@ void Agent::onSlice(wire::SliceFeatures&& s, size_t bytes) {
   }
   p.bytes += bytes;
   p.last_slice = p.last_progress = now;
-  if (!p.incoming->complete()) return;
+  if (p.incoming->complete()) completeTransfer(s.agent().to_string(), p);
+}
+
+void Agent::completeTransfer(const std::string& owner, PeerMap& p) {
   p.features = std::make_shared<MapFeatures>(p.incoming->build({}));
-  const double span = seconds(p.last_slice - p.requested);
-  const double rate = rateKbps(p);
-  log_.info("received the map of " + s.agent().to_string() + ": " + std::to_string(p.incoming->sliceCount()) + " slices, " +
-            std::to_string(p.bytes) + " bytes in " + std::to_string(p.samples) + " samples, " + fixed(span, 2) +
-            " s after our request (" + fixed(rate, 0) + " kbit/s while sending)");
+  const double span = p.samples ? seconds(p.last_slice - p.requested) : 0;
+  auto& history = transfers_[owner];
+  history.push_back({p.incoming->announcement().version(), p.incoming->sliceCount(), p.reused, p.bytes, span});
+  if (history.size() > 8) history.pop_front();
+  log_.info("received the map of " + owner + ": " + std::to_string(p.incoming->sliceCount()) + " slices (" +
+            std::to_string(p.reused) + " kept from the previous version), " + std::to_string(p.bytes) + " bytes in " +
+            std::to_string(p.samples) + " samples, " + fixed(span, 2) + " s after our request (" +
+            fixed(rateKbps(p), 0) + " kbit/s while sending)");
+  persist(false);
 }
 
 void Agent::onRequest(wire::ChunkRequest&& r) {
   if (r.requester().to_string() == config_.agent() || r.owner().to_string() != config_.agent()) return;
-  if (!known(r.requester().to_string(), "a request")) return;
+  if (!fromKnown(r.requester().to_string(), "a request")) return;
   if (r.version() != offer_.announcement.version()) return;  // an old version: the announcement tells them
   std::vector<int> wanted;
   if (r.slices().empty())
@@ -171,7 +197,7 @@ void Agent::onRequest(wire::ChunkRequest&& r) {
 }
 
 void Agent::onClaim(wire::MatchClaim&& c) {
-  if (c.claimer().to_string() == config_.agent() || !known(c.claimer().to_string(), "a claim")) return;
+  if (c.claimer().to_string() == config_.agent() || !fromKnown(c.claimer().to_string(), "a claim")) return;
   const PairKey key{c.target().to_string(), c.source().to_string()};
   Claim& held = claims_[key];
   // Keep the claim that wins: lowest claimer id among current ones.
@@ -184,7 +210,7 @@ void Agent::onClaim(wire::MatchClaim&& c) {
 void Agent::onEstimate(wire::TransformEstimate&& e) {
   if (e.computed_by().to_string() == config_.agent()) return;  // our own, stored already
   if (!known(e.target().to_string(), "an estimate") || !known(e.source().to_string(), "an estimate") ||
-      !known(e.computed_by().to_string(), "an estimate"))
+      !fromKnown(e.computed_by().to_string(), "an estimate"))
     return;
   if (e.target().to_string() >= e.source().to_string()) return reject(e.computed_by().to_string(), "estimate with an unordered pair");
   for (double v : {e.x(), e.y(), e.z(), e.yaw()})
@@ -374,134 +400,6 @@ void Agent::finishCompute() {
   results_[key] = computed_;
   bus_->publish(computed_);
   persist(true);
-}
-
-void Agent::persist(bool transforms_changed) {
-  const fs::path dir(config_.output_dir);
-  try {
-    if (transforms_changed) {
-      nlohmann::json list = nlohmann::json::array();
-      for (const auto& [key, e] : results_) list.push_back(toJson(e));
-      writeJsonAtomically((dir / "transforms.json").string(), {{"agent", config_.agent()}, {"transforms", list}});
-    }
-    nlohmann::json peers = nlohmann::json::object();
-    for (const auto& peer : config_.transport.peers) {
-      nlohmann::json j{{"alive", alive_.count(peer.id) > 0}};
-      const auto it = peers_.find(peer.id);
-      if (it != peers_.end() && it->second.incoming) {
-        const PeerMap& p = it->second;
-        const double span = seconds(p.last_slice - p.requested);
-        j["version"] = versionText(p.incoming->announcement().version());
-        j["slices_received"] = p.incoming->slicesDone();
-        j["slices_total"] = p.incoming->sliceCount();
-        j["bytes_received"] = p.bytes;
-        j["samples_received"] = p.samples;
-        j["complete"] = p.features != nullptr;
-        j["transfer_seconds"] = span;
-        j["rate_kbps"] = rateKbps(p);
-      }
-      peers[peer.id] = j;
-    }
-    const auto& a = offer_.announcement;
-    nlohmann::json status{{"agent", config_.agent()},
-                          {"pid", ::getpid()},
-                          {"uptime_s", seconds(Clock::now() - started_)},
-                          {"map",
-                           {{"path", config_.map},
-                            {"version", versionText(a.version())},
-                            {"slices", a.slices().size()},
-                            {"payload_bytes", offer_.payload_bytes},
-                            {"raw_bytes", a.raw_bytes()}}},
-                          {"bandwidth_kbps", config_.transport.bandwidth_kbps},
-                          {"sent", {{"bytes", counters_.bytes_sent}, {"samples", counters_.samples_sent}}},
-                          {"peers", peers},
-                          {"pairs_agreed", results_.size()},
-                          {"matches_computed", counters_.matches_computed},
-                          {"dropped_unknown_agent", counters_.unknown_agent},
-                          {"rejected_samples", counters_.rejected}};
-    writeJsonAtomically((dir / "status.json").string(), status);
-  } catch (const std::exception& e) {
-    log_.error(std::string("cannot write state: ") + e.what());
-  }
-}
-
-int Agent::run(const std::atomic<bool>& stop) {
-  log_.info(describe(config_));
-  std::error_code ec;
-  fs::create_directories(config_.output_dir, ec);
-  if (ec) {
-    log_.error(config_.output_dir + ": cannot create the output directory: " + ec.message());
-    return 2;
-  }
-  try {
-    describeOwnMap();
-  } catch (const InputError& e) {
-    log_.error(e.what());
-    return 2;
-  }
-  transport::BusHandlers h;
-  h.announcement = [this](wire::MapAnnouncement&& a) {
-    post([this, a = std::move(a)]() mutable { onAnnouncement(std::move(a)); });
-  };
-  h.slice = [this](wire::SliceFeatures&& s, size_t bytes) {
-    post([this, s = std::move(s), bytes]() mutable { onSlice(std::move(s), bytes); });
-  };
-  h.request = [this](wire::ChunkRequest&& r) { post([this, r = std::move(r)]() mutable { onRequest(std::move(r)); }); };
-  h.claim = [this](wire::MatchClaim&& c) { post([this, c = std::move(c)]() mutable { onClaim(std::move(c)); }); };
-  h.estimate = [this](wire::TransformEstimate&& e) {
-    post([this, e = std::move(e)]() mutable { onEstimate(std::move(e)); });
-  };
-  h.peer = [this](const std::string& name, bool alive) { post([this, name, alive] { onPeer(name, alive); }); };
-  try {
-    bus_ = std::make_unique<transport::Bus>(config_.transport, h);
-  } catch (const std::exception& e) {
-    log_.error(e.what());
-    return 2;
-  }
-  bus_->publish(offer_.announcement);
-  persist(true);
-  log_.info("ready: announced version " + versionText(offer_.announcement.version()) + " to " +
-            std::to_string(config_.transport.peers.size()) + " peers");
-
-  auto last_announce = Clock::now();
-  while (!stop) {
-    std::deque<std::function<void()>> work;
-    {
-      std::unique_lock<std::mutex> lock(queue_mutex_);
-      queue_cv_.wait_for(lock, kTick, [this] { return !queue_.empty() || worker_done_; });
-      work.swap(queue_);
-    }
-    for (auto& w : work) w();
-    {
-      // Decide on claims only with every received event applied: work above
-      // may have taken long (ORB on a received map) while claims arrived.
-      std::lock_guard<std::mutex> lock(queue_mutex_);
-      if (!queue_.empty()) continue;
-    }
-    finishCompute();
-    pumpSends();
-    requestMissing();
-    claimAndCompute();
-    const auto now = Clock::now();
-    if (now - last_announce > kReannounce) {  // repairs a lost or missed announcement
-      bus_->publish(offer_.announcement);
-      last_announce = now;
-    }
-    if (now - last_status_ > kStatusEvery) {
-      persist(false);
-      last_status_ = now;
-    }
-  }
-  log_.info("stopping");
-  persist(true);
-  if (computing_ && !worker_done_) {
-    // A match in progress is abandoned: the result would be recomputed by the
-    // fleet. Leave without waiting for it; everything else is flushed.
-    worker_.detach();
-  }
-  bus_.reset();
-  log_.info("stopped");
-  return 0;
 }
 
 }  // namespace tomomap::daemon

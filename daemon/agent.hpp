@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <deque>
 #include <functional>
+#include <future>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -16,6 +17,8 @@
 
 #include "config.hpp"
 #include "log.hpp"
+#include "map_watch.hpp"
+#include "notify.hpp"
 #include "transport/bus.hpp"
 #include "transport/slice_codec.hpp"
 
@@ -26,6 +29,24 @@ using Clock = std::chrono::steady_clock;
 /// An ordered pair of agents: target < source by id.
 using PairKey = std::pair<std::string, std::string>;
 
+/// What the signal thread tells the agent: set there, acted on in the loop.
+struct Signals {
+  std::atomic<bool> stop{false};
+  std::atomic<bool> reload{false};  ///< SIGHUP: read the config and the map again
+};
+
+/// This agent's own map, described and cut into samples.
+struct OwnMap {
+  std::shared_ptr<const MapFeatures> features;
+  transport::MapOffer offer;
+  size_t cells = 0;       ///< voxel-filtered points
+  double seconds = 0;     ///< time taken to describe it
+};
+
+/// Loads, describes and encodes the map the config names. Throws InputError
+/// for an unreadable map. Pure work: safe to run on any thread.
+OwnMap describeOwnMap(const Config& config);
+
 class Agent {
  public:
   Agent(Config config, Log& log);
@@ -33,7 +54,7 @@ class Agent {
 
   /// Loads and describes the map, joins the network and serves until `stop`.
   /// Returns the process exit code.
-  int run(const std::atomic<bool>& stop);
+  int run(Signals& signals);
 
  private:
   struct PeerMap {
@@ -43,6 +64,13 @@ class Agent {
     Clock::time_point requested{};  ///< when this version was first asked for: the transfer's start
     Clock::time_point first_slice{}, last_slice{};
     size_t bytes = 0, samples = 0;
+    size_t reused = 0;  ///< slices kept from the previous version
+  };
+  /// A finished transfer of one version of a peer's map, for status.json.
+  struct Transfer {
+    uint64_t version = 0;
+    size_t slices = 0, reused = 0, bytes = 0;
+    double seconds = 0;
   };
   struct Claim {
     std::string claimer;
@@ -54,9 +82,20 @@ class Agent {
   };
 
   void post(std::function<void()> work);
-  void describeOwnMap();
+  /// Makes `own` the map this agent offers; announces it when on the network.
+  void installOwnMap(OwnMap own);
+  /// Starts describing the map again on a helper thread once its file has
+  /// been quiet for a moment, and installs the result when it is a new version.
+  void followMapFile();
+  /// SIGHUP: a new config (kept only if it reads and is valid) and the map.
+  void reload();
+  void joinNetwork();
+  /// Notes that `sender` spoke; false (and counted) for an agent not in the config.
+  bool fromKnown(const std::string& sender, const char* what);
   void onAnnouncement(wire::MapAnnouncement&& a);
   void onSlice(wire::SliceFeatures&& s, size_t bytes);
+  /// Builds a peer's map once every slice is in, and records the transfer.
+  void completeTransfer(const std::string& owner, PeerMap& p);
   void onRequest(wire::ChunkRequest&& r);
   void onClaim(wire::MatchClaim&& c);
   void onEstimate(wire::TransformEstimate&& e);
@@ -73,12 +112,20 @@ class Agent {
   void claimAndCompute();
   void finishCompute();
   void persist(bool transforms_changed);
+  /// One line of progress for systemd's STATUS= (and `systemctl status`).
+  std::string statusLine() const;
   std::optional<uint64_t> versionOf(const std::string& agent) const;
   std::shared_ptr<const MapFeatures> featuresOf(const std::string& agent) const;
 
   Config config_;
   Log& log_;
   std::unique_ptr<transport::Bus> bus_;
+  transport::BusHandlers handlers_;
+  Notifier notifier_;
+  std::unique_ptr<MapWatch> watch_;
+  std::optional<Clock::time_point> map_touched_;  ///< last change seen and not yet described
+  std::future<OwnMap> describing_;
+  uint64_t map_updated_ms_ = 0;
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
   std::deque<std::function<void()>> queue_;
@@ -99,6 +146,8 @@ class Agent {
   std::map<PairKey, Clock::time_point> own_claims_;  ///< pairs we claimed, and when
   std::map<PairKey, wire::TransformEstimate> results_;
   std::set<std::string> alive_;  ///< peers whose participant is discovered
+  std::map<std::string, uint64_t> last_seen_ms_;  ///< wall time of each peer's last sample
+  std::map<std::string, std::deque<Transfer>> transfers_;  ///< finished transfers per peer, latest last
   Counters counters_;
 
   std::thread worker_;

@@ -2,6 +2,7 @@
 
 #include <toml++/toml.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <regex>
 #include <set>
@@ -119,7 +120,9 @@ Config loadConfig(const std::string& path) {
   t.data_port = static_cast<uint16_t>(r.number(root, "data_port", t.discovery_port + 1.0, 1024, 65535));
   if (t.data_port == t.discovery_port) r.fail(*root.get("data_port"), "data_port", "must differ from discovery_port");
   t.bandwidth_kbps = r.number(root, "bandwidth_kbps", 10000, 64, 10'000'000);
-  c.output_dir = resolve(r.text(root, "output_dir", "/var/lib/tomomap"));
+  // Under systemd, StateDirectory= names the place (STATE_DIRECTORY).
+  const char* state_dir = std::getenv("STATE_DIRECTORY");
+  c.output_dir = resolve(r.text(root, "output_dir", state_dir && *state_dir ? state_dir : "/var/lib/tomomap"));
   const std::string level = r.text(root, "log_level", "info");
   if (level == "debug") c.log_level = LogLevel::Debug;
   else if (level == "info") c.log_level = LogLevel::Info;

@@ -56,17 +56,17 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
-  std::atomic<bool> stop{false};
-  std::thread([&signals, &stop, &log] {
+  static Signals flags;  // outlives the detached thread
+  std::thread([&signals, &log] {
     for (;;) {
       int sig = 0;
       if (sigwait(&signals, &sig) != 0) continue;
       if (sig == SIGHUP) {
-        log.info("SIGHUP: reload is not supported yet; restart the service to apply a new config");
+        flags.reload = true;  // the agent's loop reloads
         continue;
       }
       log.info(std::string("received ") + (sig == SIGTERM ? "SIGTERM" : "SIGINT"));
-      stop = true;
+      flags.stop = true;
       return;
     }
   }).detach();
@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
   int code = 3;
   try {
     Agent agent(config, log);
-    code = agent.run(stop);
+    code = agent.run(flags);
     // A match still running on the worker is abandoned: leave without
     // unwinding it (results and state are already on disk, DDS is closed).
     std::fflush(nullptr);

@@ -61,13 +61,15 @@ class Fleet {
     return path;
   }
 
-  void start(const AgentSpec& spec, const std::vector<AgentSpec>& everyone) {
+  /// Starts `spec`'s daemon; `env` ("NAME=value") is added to its environment.
+  void start(const AgentSpec& spec, const std::vector<AgentSpec>& everyone, const std::vector<std::string>& env = {}) {
     const std::string config = writeConfig(spec, everyone);
     const std::string log = dir_ / (spec.id + ".log");
     const pid_t pid = fork();
     if (pid == 0) {
       FILE* f = freopen(log.c_str(), "a", stderr);
       (void)f;
+      for (const auto& e : env) putenv(const_cast<char*>(e.c_str()));
       execl(TOMOMAPD_BIN, TOMOMAPD_BIN, "--config", config.c_str(), static_cast<char*>(nullptr));
       _exit(127);
     }
@@ -131,6 +133,19 @@ class Fleet {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
     return false;
+  }
+
+  pid_t pid(const std::string& id) const { return pids_.at(id); }
+
+  /// Polls `pred` until it holds or `timeout` passes.
+  template <typename Pred>
+  static bool waitFor(Pred pred, std::chrono::milliseconds timeout) {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < until) {
+      if (pred()) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return pred();
   }
 
   std::string log(const std::string& id) const {

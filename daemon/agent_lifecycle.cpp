@@ -1,0 +1,200 @@
+// The agent's life: start, the event loop, following the map file, SIGHUP
+// reloads and a clean stop.
+#include <filesystem>
+
+#include "agent.hpp"
+#include "agent_detail.hpp"
+#include "state_files.hpp"
+
+namespace tomomap::daemon {
+
+using namespace detail;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr auto kTick = std::chrono::milliseconds(50);
+constexpr auto kReannounce = std::chrono::seconds(5);
+constexpr auto kStatusEvery = std::chrono::seconds(1);
+/// A map file must be quiet this long before it is read: writers that open,
+/// write and close it several times are done by then.
+constexpr auto kMapSettle = std::chrono::milliseconds(1000);
+
+bool sameNetwork(const transport::TransportConfig& a, const transport::TransportConfig& b) {
+  if (a.domain != b.domain || a.address != b.address || a.discovery_port != b.discovery_port ||
+      a.data_port != b.data_port || a.bandwidth_kbps != b.bandwidth_kbps || a.peers.size() != b.peers.size())
+    return false;
+  for (size_t i = 0; i < a.peers.size(); ++i)
+    if (a.peers[i].id != b.peers[i].id || a.peers[i].host != b.peers[i].host || a.peers[i].port != b.peers[i].port)
+      return false;
+  return true;
+}
+
+bool createOutputDir(const std::string& dir, Log& log) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) log.error(dir + ": cannot create the output directory: " + ec.message());
+  return !ec;
+}
+
+}  // namespace
+
+void Agent::joinNetwork() {
+  bus_ = std::make_unique<transport::Bus>(config_.transport, handlers_);
+  bus_->publish(offer_.announcement);
+}
+
+void Agent::followMapFile() {
+  if (watch_ && watch_->changed()) map_touched_ = Clock::now();
+  if (describing_.valid()) {
+    if (describing_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    try {
+      OwnMap own = describing_.get();
+      if (own.offer.announcement.version() == offer_.announcement.version())
+        log_.info("map file rewritten with the same content: version " +
+                  versionText(offer_.announcement.version()) + " stays");
+      else
+        installOwnMap(std::move(own));
+    } catch (const std::exception& e) {
+      // Typically a file caught half-written: its next write brings us back.
+      log_.warning(std::string("map file changed but cannot be used (") + e.what() + "); still offering version " +
+                   versionText(offer_.announcement.version()));
+    }
+    return;
+  }
+  if (!map_touched_ || Clock::now() - *map_touched_ < kMapSettle) return;
+  map_touched_.reset();
+  log_.info("map file changed: describing it again");
+  // On a helper thread: the loop keeps serving peers. It gets a copy of the
+  // config and nothing of the agent's state.
+  describing_ = std::async(std::launch::async, [config = config_] { return describeOwnMap(config); });
+}
+
+void Agent::reload() {
+  notifier_.reloading();
+  log_.info("SIGHUP: reading " + config_.file + " again");
+  Config next;
+  try {
+    next = loadConfig(config_.file);
+    if (next.agent() != config_.agent())
+      throw InputError(config_.file + ": key 'agent': cannot change from '" + config_.agent() + "' to '" +
+                       next.agent() + "' while running; restart the service");
+  } catch (const InputError& e) {
+    log_.error(std::string("reload refused, the running configuration stays: ") + e.what());
+    notifier_.ready();
+    return;
+  }
+  if (!createOutputDir(next.output_dir, log_)) {
+    notifier_.ready();
+    return;
+  }
+  Config previous = std::move(config_);
+  config_ = std::move(next);
+  log_.setThreshold(config_.log_level);
+  log_.info(describe(config_));
+  if (!sameNetwork(previous.transport, config_.transport)) {
+    log_.info("network settings changed: leaving and joining again");
+    bus_.reset();
+    alive_.clear();
+    claims_.clear();
+    own_claims_.clear();
+    for (auto it = peers_.begin(); it != peers_.end();)
+      it = config_.isPeer(it->first) ? std::next(it) : peers_.erase(it);
+    try {
+      joinNetwork();
+    } catch (const std::exception& e) {
+      log_.error(std::string("cannot join with the new settings (") + e.what() + "); back to the previous ones");
+      config_ = std::move(previous);
+      log_.setThreshold(config_.log_level);
+      joinNetwork();  // worked before; if not, the error ends the process and systemd restarts it
+    }
+  }
+  watch_ = std::make_unique<MapWatch>(config_.map);
+  map_touched_ = Clock::now() - kMapSettle;  // and read the map again now
+  persist(true);
+  notifier_.ready();
+}
+
+int Agent::run(Signals& signals) {
+  log_.info(describe(config_));
+  if (!createOutputDir(config_.output_dir, log_)) return 2;
+  try {
+    installOwnMap(describeOwnMap(config_));
+  } catch (const InputError& e) {
+    log_.error(e.what());
+    return 2;
+  }
+  auto& h = handlers_;
+  h.announcement = [this](wire::MapAnnouncement&& a) {
+    post([this, a = std::move(a)]() mutable { onAnnouncement(std::move(a)); });
+  };
+  h.slice = [this](wire::SliceFeatures&& s, size_t bytes) {
+    post([this, s = std::move(s), bytes]() mutable { onSlice(std::move(s), bytes); });
+  };
+  h.request = [this](wire::ChunkRequest&& r) { post([this, r = std::move(r)]() mutable { onRequest(std::move(r)); }); };
+  h.claim = [this](wire::MatchClaim&& c) { post([this, c = std::move(c)]() mutable { onClaim(std::move(c)); }); };
+  h.estimate = [this](wire::TransformEstimate&& e) {
+    post([this, e = std::move(e)]() mutable { onEstimate(std::move(e)); });
+  };
+  h.peer = [this](const std::string& name, bool alive) { post([this, name, alive] { onPeer(name, alive); }); };
+  try {
+    joinNetwork();
+  } catch (const std::exception& e) {
+    log_.error(e.what());
+    return 2;
+  }
+  persist(true);
+  watch_ = std::make_unique<MapWatch>(config_.map);
+  if (!watch_->active())
+    log_.warning("cannot watch the folder of " + config_.map + " for changes: send SIGHUP after updating the map");
+  notifier_.ready();
+  log_.info("ready: announced version " + versionText(offer_.announcement.version()) + " to " +
+            std::to_string(config_.transport.peers.size()) + " peers");
+
+  auto last_announce = Clock::now();
+  while (!signals.stop) {
+    notifier_.tick();
+    if (signals.reload.exchange(false)) reload();
+    std::deque<std::function<void()>> work;
+    {
+      std::unique_lock<std::mutex> lock(queue_mutex_);
+      queue_cv_.wait_for(lock, kTick, [this] { return !queue_.empty() || worker_done_; });
+      work.swap(queue_);
+    }
+    for (auto& w : work) w();
+    {
+      // Decide on claims only with every received event applied: work above
+      // may have taken long (ORB on a received map) while claims arrived.
+      std::lock_guard<std::mutex> lock(queue_mutex_);
+      if (!queue_.empty()) continue;
+    }
+    finishCompute();
+    followMapFile();
+    pumpSends();
+    requestMissing();
+    claimAndCompute();
+    const auto now = Clock::now();
+    if (now - last_announce > kReannounce) {  // repairs a lost or missed announcement
+      bus_->publish(offer_.announcement);
+      last_announce = now;
+    }
+    if (now - last_status_ > kStatusEvery) {
+      persist(false);
+      notifier_.status(statusLine());
+      last_status_ = now;
+    }
+  }
+  notifier_.stopping();
+  log_.info("stopping");
+  persist(true);
+  if (computing_ && !worker_done_) {
+    // A match in progress is abandoned: the result would be recomputed by the
+    // fleet. Leave without waiting for it; everything else is flushed.
+    worker_.detach();
+  }
+  bus_.reset();
+  log_.info("stopped");
+  return 0;
+}
+
+}  // namespace tomomap::daemon

@@ -1,0 +1,219 @@
+// tomomapd as an operator runs it: under systemd's notify protocol, reloaded
+// with SIGHUP, following a map file that a SLAM system rewrites.
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "core/map_io.hpp"
+#include "fleet.hpp"
+
+using namespace tomomap;
+using namespace tomomap::test;
+using namespace std::chrono_literals;
+
+namespace {
+
+/// The receiving end of NOTIFY_SOCKET, as systemd binds it.
+class NotifySocket {
+ public:
+  explicit NotifySocket(const std::string& path) : path_(path) {
+    fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    sockaddr_un a{};
+    a.sun_family = AF_UNIX;
+    std::snprintf(a.sun_path, sizeof a.sun_path, "%s", path.c_str());
+    if (bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) ADD_FAILURE() << "cannot bind " << path;
+  }
+  ~NotifySocket() { close(fd_); }
+
+  /// Collects datagrams until one contains `wanted` or `timeout` passes.
+  bool waitFor(const std::string& wanted, std::chrono::milliseconds timeout) {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    for (;;) {
+      for (size_t i = seen_; i < messages_.size(); ++i)
+        if (messages_[i].find(wanted) != std::string::npos) {
+          seen_ = i + 1;
+          return true;
+        }
+      seen_ = messages_.size();
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - std::chrono::steady_clock::now());
+      if (left.count() <= 0) return false;
+      pollfd p{fd_, POLLIN, 0};
+      if (poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
+      char buf[4096];
+      const ssize_t n = recv(fd_, buf, sizeof buf, 0);
+      if (n > 0) messages_.emplace_back(buf, static_cast<size_t>(n));
+    }
+  }
+  /// Messages received so far (pending ones included) that contain `wanted`.
+  size_t count(const std::string& wanted) {
+    char buf[4096];
+    for (ssize_t n; (n = recv(fd_, buf, sizeof buf, MSG_DONTWAIT)) > 0;) messages_.emplace_back(buf, static_cast<size_t>(n));
+    size_t n = 0;
+    for (const auto& m : messages_) n += m.find(wanted) != std::string::npos;
+    return n;
+  }
+  std::string all() const {
+    std::string s;
+    for (const auto& m : messages_) s += m + "\n";
+    return s;
+  }
+  std::string env() const { return "NOTIFY_SOCKET=" + path_; }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  std::vector<std::string> messages_;
+  size_t seen_ = 0;
+};
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void replaceIn(const std::string& path, const std::string& from, const std::string& to) {
+  std::string text = readFile(path);
+  const auto at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << from << " not in " << path;
+  text.replace(at, from.size(), to);
+  std::ofstream(path) << text;
+}
+
+Pose4 poseOf(const nlohmann::json& t) {
+  const auto& T = t["T_target_source"];
+  return {T["x"].get<double>(), T["y"].get<double>(), T["z"].get<double>(), T["yaw"].get<double>()};
+}
+
+}  // namespace
+
+TEST(Operations, NotifiesSystemdReloadsOnSighupAndStopsCleanly) {
+  TempDir dir;
+  const auto gen = runTomomap("synth -o " + (dir / "world") + " -n 1 --noise low -s 3 --scale 0.5");
+  ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  NotifySocket notify(dir / "notify.sock");
+  Fleet fleet(dir);
+  // bravo is configured but never starts: the daemon serves regardless.
+  const std::vector<AgentSpec> agents{{"alpha", dir / "world/map_0.pcd"}, {"bravo", dir / "absent.pcd"}};
+  fleet.start(agents[0], agents, {notify.env(), "WATCHDOG_USEC=400000"});
+
+  ASSERT_TRUE(notify.waitFor("READY=1", 30s)) << notify.all() << fleet.log("alpha");
+  // READY comes once the own features are announced: the log says so before.
+  EXPECT_NE(fleet.log("alpha").find("ready: announced version"), std::string::npos);
+  ASSERT_TRUE(notify.waitFor("STATUS=0/1 peers up", 5s)) << notify.all();
+  std::this_thread::sleep_for(2s);
+  EXPECT_GE(notify.count("WATCHDOG=1"), 3u) << "pings every 0.2 s with WatchdogSec=0.4 s\n" << notify.all();
+
+  // SIGHUP applies a changed config and reads the (unchanged) map again.
+  const std::string config = dir / "alpha.toml";
+  replaceIn(config, "request_interval_s = 1", "request_interval_s = 2.5");
+  fleet.kill("alpha", SIGHUP);
+  ASSERT_TRUE(notify.waitFor("RELOADING=1", 5s)) << notify.all();
+  ASSERT_TRUE(notify.waitFor("READY=1", 5s)) << notify.all();
+  EXPECT_TRUE(Fleet::waitFor([&] { return fleet.log("alpha").find("version") != std::string::npos &&
+                                          fleet.log("alpha").find("stays") != std::string::npos; },
+                             10s))
+      << fleet.log("alpha");
+  EXPECT_NE(fleet.log("alpha").find("request_interval_s = 2.5"), std::string::npos) << fleet.log("alpha");
+
+  // A broken config is refused with its line; the daemon keeps running.
+  std::ofstream(config, std::ios::app) << "grid = \"fine\"\n";
+  fleet.kill("alpha", SIGHUP);
+  ASSERT_TRUE(notify.waitFor("READY=1", 5s)) << notify.all();
+  EXPECT_NE(fleet.log("alpha").find("reload refused"), std::string::npos) << fleet.log("alpha");
+  EXPECT_NE(fleet.log("alpha").find("alpha.toml:"), std::string::npos);
+  EXPECT_FALSE(fleet.waitExit("alpha", 500ms).has_value()) << "still running";
+
+  fleet.kill("alpha", SIGTERM);
+  const auto code = fleet.waitExit("alpha", 2000ms);
+  ASSERT_TRUE(code.has_value()) << "stops within 2 s";
+  EXPECT_EQ(*code, 0);
+  EXPECT_TRUE(notify.waitFor("STOPPING=1", 1s)) << notify.all();
+  EXPECT_EQ(fleet.readJson("alpha", "status.json")["agent"], "alpha");
+}
+
+TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  const std::string d = demoRoom() + "/";
+  // bravo's SLAM map lives in the test folder, where the test can rewrite it.
+  const Points original = loadMap(d + "demo-pcd2.pcd");
+  const std::string bravo_map = dir / "bravo.pcd";
+  savePcd(bravo_map, original);
+  Fleet fleet(dir);
+  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd"}, {"bravo", bravo_map}};
+  for (const auto& a : agents) fleet.start(a, agents);
+  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 60s)) << fleet.log("alpha") << fleet.log("bravo");
+  const std::string v1 = fleet.readJson("bravo", "status.json")["map"]["version"];
+  const size_t sent_first = fleet.readJson("bravo", "status.json")["sent"]["bytes"];
+
+  // The robot maps a cabinet: new points inside the map's bounds, 0.4-1.2 m up.
+  Points updated = original;
+  Eigen::Vector3f lo = original.front(), hi = original.front();
+  for (const auto& p : original) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const Eigen::Vector3f c = (lo + hi) / 2;
+  for (float u = -0.3f; u <= 0.3f; u += 0.01f)
+    for (float z = 0.4f; z <= 1.2f; z += 0.01f) {
+      updated.emplace_back(c.x() + u, c.y() - 0.25f, lo.z() + z);
+      updated.emplace_back(c.x() + u, c.y() + 0.25f, lo.z() + z);
+      updated.emplace_back(c.x() - 0.3f, c.y() + u * 0.8f, lo.z() + z);
+    }
+  const std::string staged = dir / "bravo.pcd.tmp";
+  savePcd(staged, updated);
+  // First a writer that is cut off half-way, in place: the daemon must keep its map.
+  const std::string bytes = readFile(staged);
+  std::ofstream(bravo_map, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() / 2);
+  ASSERT_TRUE(Fleet::waitFor([&] { return fleet.log("bravo").find("cannot be used") != std::string::npos; }, 10s))
+      << fleet.log("bravo");
+  EXPECT_EQ(fleet.readJson("bravo", "status.json")["map"]["version"], v1);
+  // Then the complete map, written beside it and renamed over it.
+  std::filesystem::rename(staged, bravo_map);
+
+  std::string v2;
+  ASSERT_TRUE(Fleet::waitFor(
+      [&] {
+        v2 = fleet.readJson("bravo", "status.json")["map"].value("version", "");
+        if (v2.empty() || v2 == v1) return false;
+        for (const char* id : {"alpha", "bravo"}) {
+          const auto t = fleet.transforms(id);
+          if (!t.count("alpha<-bravo") || t.at("alpha<-bravo")["source_version"] != v2) return false;
+        }
+        return true;
+      },
+      60s))
+      << fleet.log("alpha") << fleet.log("bravo");
+
+  const auto t = fleet.transforms("alpha").at("alpha<-bravo");
+  ASSERT_TRUE(t["reliable"].get<bool>()) << t.dump(2);
+  const Pose4 gt = Pose4::fromMatrix(loadPoseFile(d + "demo-pcd1-gtpose.txt") *
+                                     loadPoseFile(d + "demo-pcd2-gtpose.txt").inverse());
+  EXPECT_LT(poseError(poseOf(t), gt).translation, 0.05);
+  EXPECT_EQ(fleet.transforms("bravo").at("alpha<-bravo")["T_target_source"], t["T_target_source"]);
+
+  // Only the changed slices travelled the second time.
+  const auto s = fleet.readJson("alpha", "status.json");
+  const auto& transfers = s["peers"]["bravo"]["transfers"];
+  ASSERT_EQ(transfers.size(), 2u) << s.dump(2);
+  EXPECT_EQ(transfers[1]["version"], v2);
+  EXPECT_GT(transfers[1]["slices_reused"].get<int>(), 0);
+  EXPECT_LT(transfers[1]["bytes"].get<size_t>(), transfers[0]["bytes"].get<size_t>()) << transfers.dump(2);
+  const size_t sent_total = fleet.readJson("bravo", "status.json")["sent"]["bytes"];
+  EXPECT_LT(sent_total - sent_first, sent_first) << "the resend is smaller than the first transfer";
+  std::printf("first transfer %zu B (%d slices); after the update %zu B (%d of %d slices reused); bravo sent %zu then "
+              "%zu B\n",
+              transfers[0]["bytes"].get<size_t>(), transfers[0]["slices"].get<int>(),
+              transfers[1]["bytes"].get<size_t>(), transfers[1]["slices_reused"].get<int>(),
+              transfers[1]["slices"].get<int>(), sent_first, sent_total - sent_first);
+  // One computation per version of the pair, fleet-wide.
+  int computed = 0;
+  for (const char* id : {"alpha", "bravo"}) computed += fleet.readJson(id, "status.json").value("matches_computed", 0);
+  EXPECT_EQ(computed, 2);
+
+  for (const char* id : {"alpha", "bravo"}) fleet.kill(id, SIGTERM);
+  for (const char* id : {"alpha", "bravo"}) EXPECT_EQ(fleet.waitExit(id, 2000ms), 0);
+}
