@@ -109,7 +109,7 @@ Config loadConfig(const std::string& path) {
   }
 
   Config c;
-  c.file = path;
+  c.file = fs::absolute(path).lexically_normal().string();
   auto& t = c.transport;
   t.agent = checkedId(r, root, "agent");
   c.map = resolve(r.text(root, "map", std::nullopt));

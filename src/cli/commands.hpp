@@ -15,5 +15,6 @@ Command addMatchCommand(CLI::App& app);
 Command addSynthCommand(CLI::App& app);
 Command addEvalCommand(CLI::App& app);
 Command addVizCommand(CLI::App& app);
+Command addStatusCommand(CLI::App& app);
 
 }  // namespace tomomap::cli

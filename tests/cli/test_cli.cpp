@@ -206,3 +206,12 @@ TEST(Cli, VizDrawsAnAlignedOverlayAndTheWinningSlicePairs) {
   const auto bad = runTomomap(args + " -o /proc/nope");
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
 }
+
+TEST(Cli, StatusWithoutADaemonsStateSaysSo) {
+  TempDir dir;
+  expectBadInput(runTomomap("status " + (dir / "nothing")), "status.json: cannot read");
+  std::ofstream(dir / "status.json") << "{\"agent\": \"alpha\", \"map\": ";  // cut off
+  expectBadInput(runTomomap("status " + dir.path.string()), "not valid JSON");
+  std::ofstream(dir / "status.json") << "{\"agent\": \"alpha\"}";
+  expectBadInput(runTomomap("status " + dir.path.string()), "not a tomomapd status file");
+}

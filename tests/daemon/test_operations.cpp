@@ -109,6 +109,20 @@ TEST(Operations, NotifiesSystemdReloadsOnSighupAndStopsCleanly) {
   std::this_thread::sleep_for(2s);
   EXPECT_GE(notify.count("WATCHDOG=1"), 3u) << "pings every 0.2 s with WatchdogSec=0.4 s\n" << notify.all();
 
+  // The operator's view, from the state directory.
+  const std::string state = dir / "out-alpha";
+  const auto human = runTomomap("status " + state);
+  EXPECT_EQ(human.exit_code, 0) << human.output;
+  EXPECT_NE(human.output.find("tomomapd alpha: running"), std::string::npos) << human.output;
+  EXPECT_NE(human.output.find("bravo"), std::string::npos);
+  EXPECT_NE(human.output.find("down"), std::string::npos) << "bravo never started";
+  const auto machine = runTomomap("status --json " + state);
+  ASSERT_EQ(machine.exit_code, 0) << machine.output;
+  const auto j = nlohmann::json::parse(machine.output.substr(machine.output.find('{')));
+  EXPECT_TRUE(j["running"].get<bool>());
+  EXPECT_EQ(j["status"]["agent"], "alpha");
+  EXPECT_FALSE(j["status"]["peers"]["bravo"]["alive"].get<bool>());
+
   // SIGHUP applies a changed config and reads the (unchanged) map again.
   const std::string config = dir / "alpha.toml";
   replaceIn(config, "request_interval_s = 1", "request_interval_s = 2.5");
@@ -135,6 +149,9 @@ TEST(Operations, NotifiesSystemdReloadsOnSighupAndStopsCleanly) {
   EXPECT_EQ(*code, 0);
   EXPECT_TRUE(notify.waitFor("STOPPING=1", 1s)) << notify.all();
   EXPECT_EQ(fleet.readJson("alpha", "status.json")["agent"], "alpha");
+  const auto after = runTomomap("status " + state);
+  EXPECT_EQ(after.exit_code, 1) << after.output;
+  EXPECT_NE(after.output.find("NOT RUNNING"), std::string::npos) << after.output;
 }
 
 TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
@@ -209,6 +226,11 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
               transfers[0]["bytes"].get<size_t>(), transfers[0]["slices"].get<int>(),
               transfers[1]["bytes"].get<size_t>(), transfers[1]["slices_reused"].get<int>(),
               transfers[1]["slices"].get<int>(), sent_first, sent_total - sent_first);
+  const auto view = runTomomap("status " + (dir / "out-alpha"));
+  EXPECT_NE(view.output.find(std::to_string(transfers[1]["slices_reused"].get<int>()) + " kept from its previous"),
+            std::string::npos)
+      << view.output;
+  EXPECT_EQ(view.output.find("STALE"), std::string::npos) << "the agreed transform is for the current maps";
   // One computation per version of the pair, fleet-wide.
   int computed = 0;
   for (const char* id : {"alpha", "bravo"}) computed += fleet.readJson(id, "status.json").value("matches_computed", 0);

@@ -1,0 +1,165 @@
+// `tomomap status`: what a running tomomapd is doing, read from the files it
+// keeps in its state directory (status.json each second, transforms.json on
+// every agreement), so it works without joining the DDS network.
+#include <signal.h>
+
+#include <cerrno>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "commands.hpp"
+#include "core/types.hpp"
+#include "exit_codes.hpp"
+
+namespace tomomap::cli {
+namespace {
+
+using nlohmann::json;
+
+/// status.json older than this means the daemon is not serving (it writes every second).
+constexpr double kStaleSeconds = 5;
+
+struct StatusOptions {
+  std::string dir = "/var/lib/tomomap";
+  bool json = false;
+};
+
+json readJson(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string() + ": cannot read (is tomomapd's output_dir here? try sudo)");
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {
+    throw InputError(path.string() + ": not valid JSON: " + e.what());
+  }
+}
+
+double nowMs() {
+  return static_cast<double>(std::chrono::duration_cast<std::chrono::milliseconds>(
+                                 std::chrono::system_clock::now().time_since_epoch())
+                                 .count());
+}
+
+std::string ago(double ms) {
+  std::ostringstream o;
+  const double s = std::max(0.0, (nowMs() - ms) / 1000);
+  if (s < 60) o << std::fixed << std::setprecision(1) << s << " s ago";
+  else if (s < 3600) o << static_cast<int>(s / 60) << " min ago";
+  else o << std::fixed << std::setprecision(1) << s / 3600 << " h ago";
+  return o.str();
+}
+
+std::string kB(double bytes) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(1) << bytes / 1000 << " kB";
+  return o.str();
+}
+
+std::string num(double v, int digits) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(digits) << v;
+  return o.str();
+}
+
+bool processAlive(int pid) { return pid > 0 && (::kill(pid, 0) == 0 || errno == EPERM); }
+
+/// The version each agent's map has now, as far as this daemon knows.
+std::map<std::string, std::string> currentVersions(const json& status) {
+  std::map<std::string, std::string> v{{status.value("agent", ""), status["map"].value("version", "")}};
+  for (const auto& [id, p] : status["peers"].items())
+    if (p.contains("version")) v[id] = p["version"];
+  return v;
+}
+
+void printHuman(const json& status, const json& transforms, bool running) {
+  const json& map = status["map"];
+  std::cout << "tomomapd " << status.value("agent", "?") << ": "
+            << (running ? "running (pid " + std::to_string(status.value("pid", 0)) + ", up " +
+                              num(status.value("uptime_s", 0.0) / 60, 1) + " min)"
+                        : "NOT RUNNING")
+            << "; status written " << ago(status.value("written_at_ms", 0.0)) << "\n";
+  std::cout << "  config   " << status.value("config", "?") << "\n";
+  std::cout << "  map      " << map.value("path", "?") << "\n           version " << map.value("version", "?")
+            << ", " << map.value("slices", 0) << " slices, payload " << kB(map.value("payload_bytes", 0.0)) << " ("
+            << num(100.0 * map.value("payload_bytes", 0.0) / std::max(1.0, map.value("raw_bytes", 1.0)), 1)
+            << " % of the map's binary PCD)" << (map.value("updating", false) ? ", an update is being described" : "")
+            << "\n";
+  std::cout << "  sent     " << kB(status["sent"].value("bytes", 0.0)) << " in " << status["sent"].value("samples", 0)
+            << " samples, budget " << status.value("bandwidth_kbps", 0.0) << " kbit/s\n";
+  std::cout << "  peers\n";
+  for (const auto& [id, p] : status["peers"].items()) {
+    std::cout << "    " << std::left << std::setw(12) << id << std::right << (p.value("alive", false) ? "up  " : "down")
+              << "  " << p.value("host", "") << ":" << p.value("port", 0) << "  last seen "
+              << (p.contains("last_seen_ms") ? ago(p["last_seen_ms"].get<double>()) : "never");
+    if (p.contains("version"))
+      std::cout << "\n        map " << p["version"].get<std::string>() << ": " << p.value("slices_received", 0) << "/"
+                << p.value("slices_total", 0) << " slices (" << p.value("slices_reused", 0)
+                << " kept from its previous version), " << kB(p.value("bytes_received", 0.0)) << " received"
+                << (p.value("complete", false) ? ", complete" : ", in transfer") << ", "
+                << num(p.value("rate_kbps", 0.0), 0) << " kbit/s";
+    std::cout << "\n";
+  }
+  const auto versions = currentVersions(status);
+  const json& list = transforms["transforms"];
+  std::cout << "  transforms (" << list.size() << ")\n";
+  for (const auto& t : list) {
+    const std::string target = t.value("target", "?"), source = t.value("source", "?");
+    std::cout << "    " << target << " <- " << source << "  ";
+    if (t.value("reliable", false)) {
+      const json& T = t["T_target_source"];
+      std::cout << "x " << num(T["x"], 3) << "  y " << num(T["y"], 3) << "  z " << num(T["z"], 3) << "  yaw "
+                << num(T["yaw"].get<double>() * 180 / M_PI, 2) << " deg";
+    } else {
+      std::cout << "no reliable match: " << t.value("reason", "");
+    }
+    const json& q = t["quality"];
+    std::cout << "\n        support " << q.value("support", 0) << " slice pairs (runner-up " << q.value("runner_up_support", 0)
+              << "), " << q.value("inliers", 0) << " inliers; computed by " << t.value("computed_by", "?") << " in "
+              << num(t.value("matching_seconds", 0.0), 2) << " s, " << ago(t.value("computed_at_ms", 0.0));
+    const bool current = versions.count(target) && versions.count(source) &&
+                         versions.at(target) == t.value("target_version", "") &&
+                         versions.at(source) == t.value("source_version", "");
+    std::cout << (current ? "" : "; STALE: a map changed since, recomputing") << "\n";
+  }
+}
+
+int runStatus(const StatusOptions& o) {
+  const std::filesystem::path dir(o.dir);
+  const json status = readJson(dir / "status.json");
+  json transforms = std::filesystem::exists(dir / "transforms.json") ? readJson(dir / "transforms.json")
+                                                                      : json{{"transforms", json::array()}};
+  if (!status.contains("map") || !status.contains("peers") || !transforms["transforms"].is_array())
+    throw InputError((dir / "status.json").string() + ": not a tomomapd status file");
+  const bool fresh = (nowMs() - status.value("written_at_ms", 0.0)) / 1000 < kStaleSeconds;
+  const bool running = fresh && processAlive(status.value("pid", 0));
+  if (o.json) {
+    std::cout << json{{"running", running}, {"status", status}, {"transforms", transforms["transforms"]}}.dump(2)
+              << "\n";
+  } else {
+    printHuman(status, transforms, running);
+  }
+  return running ? kExitOk : kExitNoMatch;
+}
+
+}  // namespace
+
+Command addStatusCommand(CLI::App& app) {
+  auto o = std::make_shared<StatusOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "status",
+      "Show what a running tomomapd is doing: its map, peers, transfers and agreed transforms.\n"
+      "Exit codes: 0 running, 1 not running (the files are from an earlier run), 2 no readable state.");
+  sub->add_option("state_dir", o->dir, "the daemon's output_dir (the service's StateDirectory)")
+      ->capture_default_str();
+  sub->add_flag("--json", o->json, "print one JSON document for scripts instead of text");
+  return {sub, [o] { return runStatus(*o); }};
+}
+
+}  // namespace tomomap::cli
