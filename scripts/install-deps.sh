@@ -11,6 +11,7 @@ PACKAGES=(
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libsystemd-dev zlib1g-dev libpng-dev
   python3 time
+  file dpkg-dev systemd  # CPack's .deb dependency scan; systemd-analyze checks the unit in the tests
 )
 
 missing=()
