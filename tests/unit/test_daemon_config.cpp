@@ -1,8 +1,11 @@
 // tomomapd's config file: defaults, errors with file, line and key.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 
 #include "config.hpp"
 #include "support.hpp"
@@ -67,4 +70,32 @@ TEST(DaemonConfig, EveryKeyIsInTheReference) {
     if (key.rfind("peer.", 0) == 0) key = key.substr(5);
     EXPECT_NE(doc.find("`" + key + "`"), std::string::npos) << key << " is not in docs/configuration.md";
   }
+}
+
+TEST(DaemonConfig, EveryKeyInTheReferenceIsOneTheDaemonReads) {
+  std::ifstream in(std::string(TOMOMAP_SOURCE_DIR) + "/docs/configuration.md");
+  std::string line;
+  size_t rows = 0;
+  const std::regex row(R"(^\| (`\[\[peer\]\]` )?`([a-z_]+)` \|)");
+  while (std::getline(in, line)) {
+    std::smatch m;
+    if (!std::regex_search(line, m, row)) continue;
+    ++rows;
+    const std::string key = (m[1].matched ? "peer." : "") + m[2].str();
+    const auto& keys = configKeys();
+    EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end()) << key << " is documented but not read";
+  }
+  EXPECT_EQ(rows, configKeys().size()) << "one table row per key";
+}
+
+TEST(DaemonConfig, EveryShippedConfigLoads) {
+  // The examples users copy, the local demo's and the containers' configs.
+  size_t n = 0;
+  for (const char* folder : {"config", "config/local-3-agents", "docker/config"})
+    for (const auto& e : std::filesystem::directory_iterator(std::string(TOMOMAP_SOURCE_DIR) + "/" + folder)) {
+      if (e.path().extension() != ".toml") continue;
+      ++n;
+      EXPECT_NO_THROW(loadConfig(e.path().string())) << e.path();
+    }
+  EXPECT_GE(n, 7u);
 }
