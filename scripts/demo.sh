@@ -24,3 +24,6 @@ for id in alpha bravo charlie; do
 done
 echo "== three daemons started (logs: $out/*.log); waiting for every pair to be agreed"
 python3 scripts/demo_watch.py "$out" "$start"
+echo
+echo "== what an operator sees on robot alpha: tomomap status $out/alpha"
+"$build/src/cli/tomomap" status "$out/alpha"
