@@ -127,10 +127,9 @@ struct Bus::Impl {
 
 Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<Impl>()) {
   auto& i = *impl_;
-  i.participant = createParticipant(config);
+  i.watch = std::make_unique<ParticipantWatch>(h.peer);
+  i.participant = createParticipant(config, i.watch.get());
   try {
-    i.watch = std::make_unique<ParticipantWatch>(h.peer);
-    i.participant->set_listener(i.watch.get(), StatusMask::none());
     i.publisher = i.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
     i.subscriber = i.participant->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
     if (!i.publisher || !i.subscriber) throw std::runtime_error("cannot create publisher/subscriber");

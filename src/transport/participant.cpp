@@ -46,7 +46,7 @@ Locator_t udp(const std::string& host, uint16_t port) {
 
 }  // namespace
 
-DomainParticipant* createParticipant(const TransportConfig& c) {
+DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipantListener* listener) {
   DomainParticipantQos q;
   q.name("tomomapd/" + c.agent);
   q.transport().use_builtin_transports = false;
@@ -71,7 +71,8 @@ DomainParticipant* createParticipant(const TransportConfig& c) {
   q.flow_controllers().push_back(flow);
 
   DomainParticipant* p =
-      DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(c.domain), q);
+      DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(c.domain), q, listener,
+                                                                 StatusMask::none());
   if (!p)
     throw std::runtime_error("cannot create the DDS participant (ports " + std::to_string(c.discovery_port) + "/" +
                              std::to_string(c.data_port) + " on " + c.address + " in use?)");

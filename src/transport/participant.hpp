@@ -8,6 +8,7 @@
 
 namespace eprosima::fastdds::dds {
 class DomainParticipant;
+class DomainParticipantListener;
 }
 
 namespace tomomap::transport {
@@ -42,6 +43,9 @@ size_t bytesPerPeriod(double bandwidth_kbps);
 size_t maxSampleBytes(double bandwidth_kbps);
 
 /// Creates the participant; throws std::runtime_error naming the cause.
-eprosima::fastdds::dds::DomainParticipant* createParticipant(const TransportConfig& config);
+/// `listener` is attached at creation: set afterwards, it would miss the peers
+/// discovered in between (a peer already running is found at once).
+eprosima::fastdds::dds::DomainParticipant* createParticipant(
+    const TransportConfig& config, eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr);
 
 }  // namespace tomomap::transport
