@@ -14,7 +14,7 @@ struct Config {
   transport::TransportConfig transport;  ///< agent id, domain, address, ports, peers, bandwidth
   std::string map;                   ///< own map file (absolute, or relative to the config file)
   double grid = 0.05;                ///< [m]
-  std::string output_dir;            ///< transforms.json, status.json, cache/
+  std::string output_dir;            ///< transforms.json, status.json
   LogLevel log_level = LogLevel::Info;
   double claim_timeout_s = 30;       ///< a claim without a result is void after this [s]
   double request_interval_s = 1;     ///< ask again for missing slices after this much silence [s]

@@ -1,6 +1,7 @@
 #pragma once
 // Log lines to stderr: with syslog priority prefixes ("<6>") when journald
 // reads them (JOURNAL_STREAM is set), with a UTC time and level otherwise.
+#include <atomic>
 #include <sstream>
 #include <string>
 
@@ -19,7 +20,7 @@ class Log {
   void error(const std::string& l) const { write(LogLevel::Error, l); }
 
  private:
-  LogLevel threshold_;
+  std::atomic<LogLevel> threshold_;  ///< changed by a reload while other threads log
   bool journald_;
 };
 
