@@ -164,7 +164,9 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, uint64_t raw_
 }
 
 uint64_t mapVersion(const wire::MapAnnouncement& a) {
-  // FNV-1a over the raster geometry and every slice's index and CRC.
+  // FNV-1a over the raster geometry and every slice's index, CRC and part
+  // count: the same content cut for another bandwidth budget (a reload) is
+  // another version, so a receiver never mixes parts of two chunkings.
   uint64_t h = 1469598103934665603ull;
   auto mix = [&h](uint64_t v) {
     for (int i = 0; i < 8; ++i) {
@@ -182,7 +184,10 @@ uint64_t mapVersion(const wire::MapAnnouncement& a) {
   mix(bits(a.y_min()));
   mix(bits(a.z_min()));
   mix((uint64_t{a.width()} << 16) | a.height());
-  for (const auto& e : a.slices()) mix((uint64_t{static_cast<uint32_t>(e.slice())} << 32) | e.crc32());
+  for (const auto& e : a.slices()) {
+    mix((uint64_t{static_cast<uint32_t>(e.slice())} << 32) | e.crc32());
+    mix(e.parts());
+  }
   return h;
 }
 

@@ -27,7 +27,8 @@ struct MapOffer {
 MapOffer makeOffer(const std::string& agent, const MapFeatures& features, uint64_t raw_bytes,
                    size_t max_sample_bytes);
 
-/// Content hash of a map's description: equal maps, equal versions.
+/// Hash of a map's description and its chunking: equal maps cut for equal
+/// budgets have equal versions.
 uint64_t mapVersion(const wire::MapAnnouncement& a);
 
 /// Why an announcement or sample was rejected; empty when accepted.

@@ -158,6 +158,14 @@ TEST(SliceCodec, AMapUpdateReusesTheSlicesThatDidNotChange) {
   for (size_t i = 0; i < back.slices.size(); ++i)
     EXPECT_EQ(cv::norm(back.slices[i].descriptors, changed.slices[i].descriptors, cv::NORM_HAMMING), 0);
 
+  // The same map cut for another bandwidth budget is another version: a peer
+  // must never combine parts of two chunkings.
+  const MapOffer rechunked = makeOffer("alpha", changed, 1000000, 600);
+  bool parts_differ = false;
+  for (const auto& [k, samples] : after.samples) parts_differ |= samples.size() != rechunked.samples.at(k).size();
+  ASSERT_TRUE(parts_differ);
+  EXPECT_NE(rechunked.announcement.version(), after.announcement.version());
+
   // Another agent's slices, or a different raster, are never taken.
   wire::MapAnnouncement other = after.announcement;
   other.agent("bravo");
