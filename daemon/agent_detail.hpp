@@ -1,12 +1,11 @@
 #pragma once
-// Small helpers the agent's source files share: clocks and number formatting.
+// Small helpers the agent's source files share: clocks and pair names.
 #include <chrono>
 #include <cstdint>
-#include <iomanip>
-#include <sstream>
 #include <string>
 
 #include "agent.hpp"
+#include "core/text.hpp"
 
 namespace tomomap::daemon::detail {
 
@@ -16,12 +15,6 @@ inline uint64_t wallMs() {
   return static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::milliseconds>(
                                    std::chrono::system_clock::now().time_since_epoch())
                                    .count());
-}
-
-inline std::string fixed(double v, int digits) {
-  std::ostringstream o;
-  o << std::fixed << std::setprecision(digits) << v;
-  return o.str();
 }
 
 inline std::string pairText(const PairKey& p) { return p.first + "<-" + p.second; }

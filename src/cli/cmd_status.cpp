@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "core/text.hpp"
 #include "core/types.hpp"
 #include "exit_codes.hpp"
 
@@ -48,25 +49,13 @@ double nowMs() {
 }
 
 std::string ago(double ms) {
-  std::ostringstream o;
   const double s = std::max(0.0, (nowMs() - ms) / 1000);
-  if (s < 60) o << std::fixed << std::setprecision(1) << s << " s ago";
-  else if (s < 3600) o << static_cast<int>(s / 60) << " min ago";
-  else o << std::fixed << std::setprecision(1) << s / 3600 << " h ago";
-  return o.str();
+  if (s < 60) return fixed(s, 1) + " s ago";
+  if (s < 3600) return std::to_string(static_cast<int>(s / 60)) + " min ago";
+  return fixed(s / 3600, 1) + " h ago";
 }
 
-std::string kB(double bytes) {
-  std::ostringstream o;
-  o << std::fixed << std::setprecision(1) << bytes / 1000 << " kB";
-  return o.str();
-}
-
-std::string num(double v, int digits) {
-  std::ostringstream o;
-  o << std::fixed << std::setprecision(digits) << v;
-  return o.str();
-}
+std::string kB(double bytes) { return fixed(bytes / 1000, 1) + " kB"; }
 
 bool processAlive(int pid) { return pid > 0 && (::kill(pid, 0) == 0 || errno == EPERM); }
 
@@ -82,13 +71,13 @@ void printHuman(const json& status, const json& transforms, bool running) {
   const json& map = status["map"];
   std::cout << "tomomapd " << status.value("agent", "?") << ": "
             << (running ? "running (pid " + std::to_string(status.value("pid", 0)) + ", up " +
-                              num(status.value("uptime_s", 0.0) / 60, 1) + " min)"
+                              fixed(status.value("uptime_s", 0.0) / 60, 1) + " min)"
                         : "NOT RUNNING")
             << "; status written " << ago(status.value("written_at_ms", 0.0)) << "\n";
   std::cout << "  config   " << status.value("config", "?") << "\n";
   std::cout << "  map      " << map.value("path", "?") << "\n           version " << map.value("version", "?")
             << ", " << map.value("slices", 0) << " slices, payload " << kB(map.value("payload_bytes", 0.0)) << " ("
-            << num(100.0 * map.value("payload_bytes", 0.0) / std::max(1.0, map.value("raw_bytes", 1.0)), 1)
+            << fixed(100.0 * map.value("payload_bytes", 0.0) / std::max(1.0, map.value("raw_bytes", 1.0)), 1)
             << " % of the map's binary PCD)" << (map.value("updating", false) ? ", an update is being described" : "")
             << "\n";
   std::cout << "  sent     " << kB(status["sent"].value("bytes", 0.0)) << " in " << status["sent"].value("samples", 0)
@@ -103,7 +92,7 @@ void printHuman(const json& status, const json& transforms, bool running) {
                 << p.value("slices_total", 0) << " slices (" << p.value("slices_reused", 0)
                 << " kept from its previous version), " << kB(p.value("bytes_received", 0.0)) << " received"
                 << (p.value("complete", false) ? ", complete" : ", in transfer") << ", "
-                << num(p.value("rate_kbps", 0.0), 0) << " kbit/s";
+                << fixed(p.value("rate_kbps", 0.0), 0) << " kbit/s";
     std::cout << "\n";
   }
   const auto versions = currentVersions(status);
@@ -114,15 +103,15 @@ void printHuman(const json& status, const json& transforms, bool running) {
     std::cout << "    " << target << " <- " << source << "  ";
     if (t.value("reliable", false)) {
       const json& T = t["T_target_source"];
-      std::cout << "x " << num(T["x"], 3) << "  y " << num(T["y"], 3) << "  z " << num(T["z"], 3) << "  yaw "
-                << num(T["yaw"].get<double>() * 180 / M_PI, 2) << " deg";
+      std::cout << "x " << fixed(T["x"], 3) << "  y " << fixed(T["y"], 3) << "  z " << fixed(T["z"], 3) << "  yaw "
+                << fixed(T["yaw"].get<double>() * 180 / M_PI, 2) << " deg";
     } else {
       std::cout << "no reliable match: " << t.value("reason", "");
     }
     const json& q = t["quality"];
     std::cout << "\n        support " << q.value("support", 0) << " slice pairs (runner-up " << q.value("runner_up_support", 0)
               << "), " << q.value("inliers", 0) << " inliers; computed by " << t.value("computed_by", "?") << " in "
-              << num(t.value("matching_seconds", 0.0), 2) << " s, " << ago(t.value("computed_at_ms", 0.0));
+              << fixed(t.value("matching_seconds", 0.0), 2) << " s, " << ago(t.value("computed_at_ms", 0.0));
     const bool current = versions.count(target) && versions.count(source) &&
                          versions.at(target) == t.value("target_version", "") &&
                          versions.at(source) == t.value("source_version", "");

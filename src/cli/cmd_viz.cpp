@@ -1,10 +1,9 @@
 // `tomomap viz TARGET SOURCE -o DIR`: matches two maps and draws what happened.
 #include <filesystem>
-#include <iomanip>
 #include <iostream>
-#include <sstream>
 
 #include "commands.hpp"
+#include "core/text.hpp"
 #include "match_files.hpp"
 #include "viz/match_pictures.hpp"
 
@@ -16,12 +15,6 @@ struct VizOptions {
   std::string out = "viz-out";
   int pairs = 3;
 };
-
-std::string fixed(double v, int digits) {
-  std::ostringstream o;
-  o << std::fixed << std::setprecision(digits) << v;
-  return o.str();
-}
 
 int runViz(const VizOptions& o) {
   namespace fs = std::filesystem;

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
-#include <iomanip>
-#include <sstream>
+
+#include "core/text.hpp"
 
 namespace tomomap::viz {
 namespace {
@@ -27,12 +27,6 @@ std::vector<Eigen::Vector2d> verticalStructure(const SliceStack& s, int min_slic
     i = j;
   }
   return xy;
-}
-
-std::string metres(double v, int digits = 2) {
-  std::ostringstream o;
-  o << std::fixed << std::setprecision(digits) << v;
-  return o.str();
 }
 
 /// A slice as dark cells on white, BGR.
@@ -168,12 +162,12 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
     cv::Mat header(56, std::max(drawn.cols, 1000), CV_8UC3, colour::kWhite);
     drawText(header,
              "target slice " + std::to_string(pair.target_slice) + " (z " +
-                 metres(tg.sliceHeight(pair.target_slice)) + " m)  |  source slice " +
-                 std::to_string(pair.source_slice) + " (z " + metres(sg.sliceHeight(pair.source_slice)) + " m)",
+                 fixed(tg.sliceHeight(pair.target_slice), 2) + " m)  |  source slice " +
+                 std::to_string(pair.source_slice) + " (z " + fixed(sg.sliceHeight(pair.source_slice), 2) + " m)",
              {8, 22}, 0.55, colour::kBlack, Align::Left, 2);
     drawText(header,
              std::to_string(c.size()) + " mutual descriptor matches, " + std::to_string(inliers.size()) +
-                 " agree with the result (green, within " + metres(inlier_cells, 0) + " cells); grey: the rest",
+                 " agree with the result (green, within " + fixed(inlier_cells, 0) + " cells); grey: the rest",
              {8, 46}, 0.48);
     rows.push_back(header);
     rows.push_back(drawn);
@@ -188,7 +182,7 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
   cv::Mat head(40, std::max(out.cols, 1000), CV_8UC3, colour::kWhite);
   drawText(head,
            "winning height offset " + std::to_string(r.height_offset) + " slices (" +
-               metres(r.T_target_source.z) + " m), " + std::to_string(r.support) + " agreeing slice pairs",
+               fixed(r.T_target_source.z, 2) + " m), " + std::to_string(r.support) + " agreeing slice pairs",
            {8, 28}, 0.65, colour::kBlack, Align::Left, 2);
   return stack({head, out});
 }
