@@ -3,9 +3,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <filesystem>
-#include <iomanip>
-#include <sstream>
 
 #include "core/map_io.hpp"
 #include "core/matcher.hpp"
@@ -88,7 +85,7 @@ void Agent::installOwnMap(OwnMap own) {
 
 bool Agent::fromKnown(const std::string& sender, const char* what) {
   if (!known(sender, what)) return false;
-  if (sender != config_.agent()) last_seen_ms_[sender] = wallMs();
+  last_seen_ms_[sender] = wallMs();  // callers have set aside our own samples
   return true;
 }
 
@@ -109,6 +106,11 @@ std::optional<uint64_t> Agent::versionOf(const std::string& agent) const {
   const auto it = peers_.find(agent);
   if (it == peers_.end() || !it->second.incoming) return std::nullopt;
   return it->second.incoming->announcement().version();
+}
+
+bool Agent::isCurrent(const wire::TransformEstimate& e) const {
+  const auto vt = versionOf(e.target().to_string()), vs = versionOf(e.source().to_string());
+  return vt && vs && *vt == e.target_version() && *vs == e.source_version();
 }
 
 std::shared_ptr<const MapFeatures> Agent::featuresOf(const std::string& agent) const {
@@ -309,8 +311,7 @@ void Agent::claimAndCompute() {
       const PairKey key{holders[i], holders[j]};
       const uint64_t vt = *versionOf(key.first), vs = *versionOf(key.second);
       const auto done = results_.find(key);
-      if (done != results_.end() && done->second.target_version() == vt && done->second.source_version() == vs)
-        continue;
+      if (done != results_.end() && isCurrent(done->second)) continue;
       const auto other = claims_.find(key);
       const bool live_other = other != claims_.end() && other->second.target_version == vt &&
                               other->second.source_version == vs &&

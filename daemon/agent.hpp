@@ -115,6 +115,8 @@ class Agent {
   /// One line of progress for systemd's STATUS= (and `systemctl status`).
   std::string statusLine() const;
   std::optional<uint64_t> versionOf(const std::string& agent) const;
+  /// Whether `e` was computed for the maps' versions known now.
+  bool isCurrent(const wire::TransformEstimate& e) const;
   std::shared_ptr<const MapFeatures> featuresOf(const std::string& agent) const;
 
   Config config_;

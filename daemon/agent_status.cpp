@@ -90,10 +90,7 @@ std::string Agent::statusLine() const {
   // Pairs among this agent and its peers, and how many of them are current.
   const size_t pairs = (peers + 1) * peers / 2;
   size_t agreed = 0;
-  for (const auto& [key, e] : results_) {
-    const auto vt = versionOf(key.first), vs = versionOf(key.second);
-    agreed += vt && vs && *vt == e.target_version() && *vs == e.source_version();
-  }
+  for (const auto& [key, e] : results_) agreed += isCurrent(e);
   std::string line = std::to_string(alive_.size()) + "/" + std::to_string(peers) + " peers up; " +
                      std::to_string(maps) + "/" + std::to_string(peers) + " peer maps (" +
                      std::to_string(slices_in) + "/" + std::to_string(slices_all) + " slices); " +
