@@ -68,4 +68,21 @@ inline DemoPair loadDemoPair() {
   return p;
 }
 
+/// `map` after the robot mapped a cabinet in the middle of the room: three
+/// 0.6 x 0.8 m panels of points 0.4-1.2 m above the floor, inside the map's
+/// bounds, so a map update that changes only some slices.
+inline Points withCabinet(const Points& map) {
+  Points updated = map;
+  Eigen::Vector3f lo = map.front(), hi = map.front();
+  for (const auto& p : map) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const Eigen::Vector3f c = (lo + hi) / 2;
+  for (float u = -0.3f; u <= 0.3f; u += 0.01f)
+    for (float z = 0.4f; z <= 1.2f; z += 0.01f) {
+      updated.emplace_back(c.x() + u, c.y() - 0.25f, lo.z() + z);
+      updated.emplace_back(c.x() + u, c.y() + 0.25f, lo.z() + z);
+      updated.emplace_back(c.x() - 0.3f, c.y() + u * 0.8f, lo.z() + z);
+    }
+  return updated;
+}
+
 }  // namespace tomomap::test

@@ -169,19 +169,9 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
   const std::string v1 = fleet.readJson("bravo", "status.json")["map"]["version"];
   const size_t sent_first = fleet.readJson("bravo", "status.json")["sent"]["bytes"];
 
-  // The robot maps a cabinet: new points inside the map's bounds, 0.4-1.2 m up.
-  Points updated = original;
-  Eigen::Vector3f lo = original.front(), hi = original.front();
-  for (const auto& p : original) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  const Eigen::Vector3f c = (lo + hi) / 2;
-  for (float u = -0.3f; u <= 0.3f; u += 0.01f)
-    for (float z = 0.4f; z <= 1.2f; z += 0.01f) {
-      updated.emplace_back(c.x() + u, c.y() - 0.25f, lo.z() + z);
-      updated.emplace_back(c.x() + u, c.y() + 0.25f, lo.z() + z);
-      updated.emplace_back(c.x() - 0.3f, c.y() + u * 0.8f, lo.z() + z);
-    }
+  // The robot maps a cabinet, inside the map's bounds.
   const std::string staged = dir / "bravo.pcd.tmp";
-  savePcd(staged, updated);
+  savePcd(staged, withCabinet(original));
   // First a writer that is cut off half-way, in place: the daemon must keep its map.
   const std::string bytes = readFile(staged);
   std::ofstream(bravo_map, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() / 2);

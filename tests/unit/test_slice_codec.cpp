@@ -129,16 +129,8 @@ TEST(SliceCodec, InconsistentSamplesAreRejectedNotCrashed) {
 }
 
 TEST(SliceCodec, AMapUpdateReusesTheSlicesThatDidNotChange) {
-  // The robot's map gains a cabinet between 0.5 and 1.2 m, inside its bounds.
-  Points updated = samplePoints();
-  Eigen::Vector3f lo = updated.front(), hi = updated.front();
-  for (const auto& p : updated) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  const Eigen::Vector3f centre = (lo + hi) / 2;
-  for (float x = -0.6f; x <= 0.6f; x += 0.02f)
-    for (float z = 0.5f; z <= 1.2f; z += 0.02f) {
-      updated.emplace_back(centre.x() + x, centre.y() - 0.4f, lo.z() + z);
-      updated.emplace_back(centre.x() + x, centre.y() + 0.4f, lo.z() + z);
-    }
+  // The robot's map gains a cabinet, inside its bounds.
+  const Points updated = tomomap::test::withCabinet(samplePoints());
   const MapOffer before = makeOffer("alpha", sampleMap(), 1000000, 4000);
   const MapFeatures changed = describeAtDecimetre(updated);
   const MapOffer after = makeOffer("alpha", changed, 1000000, 4000);
