@@ -3,12 +3,10 @@
 #include <filesystem>
 
 #include "agent.hpp"
-#include "agent_detail.hpp"
-#include "state_files.hpp"
+#include "core/text.hpp"
 
 namespace tomomap::daemon {
 
-using namespace detail;
 namespace fs = std::filesystem;
 
 namespace {
@@ -41,7 +39,7 @@ bool createOutputDir(const std::string& dir, Log& log) {
 
 void Agent::joinNetwork() {
   bus_ = std::make_unique<transport::Bus>(config_.transport, handlers_);
-  bus_->publish(offer_.announcement);
+  bus_->publish(sender_.offer().announcement);
 }
 
 void Agent::followMapFile() {
@@ -50,15 +48,14 @@ void Agent::followMapFile() {
     if (describing_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
     try {
       OwnMap own = describing_.get();
-      if (own.offer.announcement.version() == offer_.announcement.version())
-        log_.info("map file rewritten with the same content: version " +
-                  versionText(offer_.announcement.version()) + " stays");
+      if (own.offer.announcement.version() == sender_.version())
+        log_.info("map file rewritten with the same content: version " + versionText(sender_.version()) + " stays");
       else
         installOwnMap(std::move(own));
     } catch (const std::exception& e) {
       // Typically a file caught half-written: its next write brings us back.
       log_.warning(std::string("map file changed but cannot be used (") + e.what() + "); still offering version " +
-                   versionText(offer_.announcement.version()));
+                   versionText(sender_.version()));
     }
     return;
   }
@@ -92,14 +89,16 @@ void Agent::reload() {
   config_ = std::move(next);
   log_.setThreshold(config_.log_level);
   log_.info(describe(config_));
+  sender_.setBudget(config_.transport.bandwidth_kbps, fromSeconds(config_.request_interval_s));
+  board_.setTimings(boardTimings(config_));
   if (!sameNetwork(previous.transport, config_.transport)) {
     log_.info("network settings changed: leaving and joining again");
     bus_.reset();
-    alive_.clear();
-    claims_.clear();
-    own_claims_.clear();
-    for (auto it = peers_.begin(); it != peers_.end();)
-      it = config_.isPeer(it->first) ? std::next(it) : peers_.erase(it);
+    peers_.clearAlive();
+    board_.leftNetwork();
+    const auto keep = [this](const std::string& id) { return config_.isPeer(id); };
+    peers_.retain(keep);
+    board_.retainMaps(keep);
     try {
       joinNetwork();
     } catch (const std::exception& e) {
@@ -113,6 +112,25 @@ void Agent::reload() {
   map_touched_ = Clock::now() - kMapSettle;  // and read the map again now
   persist(true);
   notifier_.ready();
+}
+
+void Agent::tick(Clock::time_point& last_announce) {
+  finishCompute();
+  followMapFile();
+  const auto now = Clock::now();
+  sender_.pump([this](const wire::SliceFeatures& x) { return bus_->publish(x); }, transport::Bus::serializedSize,
+               now);
+  requestMissing();
+  claimAndCompute();
+  if (now - last_announce > kReannounce) {  // repairs a lost or missed announcement
+    bus_->publish(sender_.offer().announcement);
+    last_announce = now;
+  }
+  if (now - last_status_ > kStatusEvery) {
+    persist(false);
+    notifier_.status(statusLine());
+    last_status_ = now;
+  }
 }
 
 int Agent::run(Signals& signals) {
@@ -147,9 +165,10 @@ int Agent::run(Signals& signals) {
   watch_ = std::make_unique<MapWatch>(config_.map);
   if (!watch_->active())
     log_.warning("cannot watch the folder of " + config_.map + " for changes: send SIGHUP after updating the map");
-  notifier_.ready();
-  log_.info("ready: announced version " + versionText(offer_.announcement.version()) + " to " +
+  // The log line first: whoever acts on READY=1 (a test, an operator) finds it.
+  log_.info("ready: announced version " + versionText(sender_.version()) + " to " +
             std::to_string(config_.transport.peers.size()) + " peers");
+  notifier_.ready();
 
   auto last_announce = Clock::now();
   while (!signals.stop) {
@@ -158,7 +177,7 @@ int Agent::run(Signals& signals) {
     std::deque<std::function<void()>> work;
     {
       std::unique_lock<std::mutex> lock(queue_mutex_);
-      queue_cv_.wait_for(lock, kTick, [this] { return !queue_.empty() || worker_done_; });
+      queue_cv_.wait_for(lock, kTick, [this] { return !queue_.empty() || worker_.ready(); });
       work.swap(queue_);
     }
     for (auto& w : work) w();
@@ -168,30 +187,14 @@ int Agent::run(Signals& signals) {
       std::lock_guard<std::mutex> lock(queue_mutex_);
       if (!queue_.empty()) continue;
     }
-    finishCompute();
-    followMapFile();
-    pumpSends();
-    requestMissing();
-    claimAndCompute();
-    const auto now = Clock::now();
-    if (now - last_announce > kReannounce) {  // repairs a lost or missed announcement
-      bus_->publish(offer_.announcement);
-      last_announce = now;
-    }
-    if (now - last_status_ > kStatusEvery) {
-      persist(false);
-      notifier_.status(statusLine());
-      last_status_ = now;
-    }
+    tick(last_announce);
   }
   notifier_.stopping();
   log_.info("stopping");
   persist(true);
-  if (computing_ && !worker_done_) {
-    // A match in progress is abandoned: the result would be recomputed by the
-    // fleet. Leave without waiting for it; everything else is flushed.
-    worker_.detach();
-  }
+  // A match in progress is abandoned: the result would be recomputed by the
+  // fleet. Leave without waiting for it; everything else is flushed.
+  worker_.abandon();
   bus_.reset();
   log_.info("stopped");
   return 0;

@@ -15,10 +15,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kKeys{"agent",          "map",        "grid",          "domain",
-                                     "address",        "discovery_port", "data_port", "bandwidth_kbps",
-                                     "output_dir",     "log_level",  "claim_timeout_s", "request_interval_s",
-                                     "peer.id",        "peer.host",  "peer.port"};
+const std::vector<std::string> kKeys{
+    "agent",          "map",        "grid",           "domain",          "address",
+    "discovery_port", "data_port",  "bandwidth_kbps", "output_dir",      "log_level",
+    "claim_timeout_s", "request_interval_s", "peer.id", "peer.host",     "peer.port",
+    "match.max_features", "match.fast_threshold", "match.ransac_threshold_cells", "match.ransac_iterations",
+    "match.ransac_confidence", "match.min_matches", "match.consensus_translation_cells",
+    "match.consensus_yaw_deg", "match.min_support", "match.min_inliers", "match.threads"};
 
 struct Reader {
   std::string file;
@@ -28,6 +31,13 @@ struct Reader {
     throw InputError(file + ":" + std::to_string(b.line) + ":" + std::to_string(b.column) + ": key '" + key + "': " +
                      what);
   }
+  /// An integer key: a number from lo to hi with no fraction.
+  int integer(const toml::table& t, const std::string& key, int fallback, int lo, int hi) const {
+    const double v = number(t, key, fallback, lo, hi);
+    if (v != static_cast<int>(v)) fail(*t.get(key), key, "must be a whole number");
+    return static_cast<int>(v);
+  }
+
   [[noreturn]] void missing(const toml::table& t, const std::string& key) const {
     const auto& b = t.source().begin;
     throw InputError(file + ":" + std::to_string(b.line) + ":" + std::to_string(b.column) + ": key '" + key +
@@ -71,6 +81,31 @@ std::string checkedId(const Reader& r, const toml::table& t, const std::string& 
   return id;
 }
 
+/// The [match] table: each key overrides one MatchParams field; absent keys
+/// keep the matcher's own defaults.
+void readMatch(const Reader& r, const toml::table& root, MatchParams& m) {
+  const toml::node* node = root.get("match");
+  if (!node) return;
+  const toml::table* t = node->as_table();
+  if (!t) r.fail(*node, "match", "must be a table ([match])");
+  for (const auto& [key, value] : *t)
+    if (std::find(kKeys.begin(), kKeys.end(), "match." + std::string(key.str())) == kKeys.end())
+      r.fail(value, "match." + std::string(key.str()), "unknown key (see docs/configuration.md)");
+  const Reader in{r.file};
+  m.features.max_features = in.integer(*t, "max_features", m.features.max_features, 1, 10000);
+  m.features.fast_threshold = in.integer(*t, "fast_threshold", m.features.fast_threshold, 1, 255);
+  m.ransac_threshold_cells = in.number(*t, "ransac_threshold_cells", m.ransac_threshold_cells, 0.5, 50);
+  m.ransac_iterations = in.integer(*t, "ransac_iterations", m.ransac_iterations, 10, 100000);
+  m.ransac_confidence = in.number(*t, "ransac_confidence", m.ransac_confidence, 0.5, 0.999999);
+  m.min_matches = in.integer(*t, "min_matches", m.min_matches, 2, 1000);
+  m.consensus_translation_cells =
+      in.number(*t, "consensus_translation_cells", m.consensus_translation_cells, 0.5, 100);
+  m.consensus_yaw = radians(in.number(*t, "consensus_yaw_deg", degrees(m.consensus_yaw), 0.1, 90));
+  m.min_support = in.integer(*t, "min_support", m.min_support, 1, 1000);
+  m.min_inliers = in.integer(*t, "min_inliers", m.min_inliers, 2, 100000);
+  m.threads = in.integer(*t, "threads", m.threads, 0, 256);
+}
+
 std::string checkedAddress(const Reader& r, const toml::table& t, const std::string& key,
                            const std::optional<std::string>& fallback) {
   const std::string a = r.text(t, key, fallback);
@@ -104,7 +139,7 @@ Config loadConfig(const std::string& path) {
   auto resolve = [&](const std::string& p) { return (base / p).lexically_normal().string(); };
   for (const auto& [key, node] : root) {
     const std::string k(key.str());
-    if (k != "peer" && std::find(kKeys.begin(), kKeys.end(), k) == kKeys.end())
+    if (k != "peer" && k != "match" && std::find(kKeys.begin(), kKeys.end(), k) == kKeys.end())
       r.fail(node, k, "unknown key (see docs/configuration.md)");
   }
 
@@ -113,7 +148,8 @@ Config loadConfig(const std::string& path) {
   auto& t = c.transport;
   t.agent = checkedId(r, root, "agent");
   c.map = resolve(r.text(root, "map", std::nullopt));
-  c.grid = r.number(root, "grid", 0.05, 0.005, 10);
+  c.match.grid = r.number(root, "grid", c.match.grid, 0.005, 10);
+  readMatch(r, root, c.match);
   t.domain = static_cast<int>(r.number(root, "domain", 0, 0, 232));
   t.address = checkedAddress(r, root, "address", "127.0.0.1");
   t.discovery_port = static_cast<uint16_t>(r.number(root, "discovery_port", std::nullopt, 1024, 65534));
@@ -159,12 +195,20 @@ std::string describe(const Config& c) {
   static const char* levels[] = {"debug", "info", "warning", "error"};
   std::ostringstream o;
   const auto& t = c.transport;
+  const MatchParams& m = c.match;
   o << "config " << c.file << "\n"
-    << "  agent = " << t.agent << "\n  map = " << c.map << "\n  grid = " << c.grid << "\n  domain = " << t.domain
+    << "  agent = " << t.agent << "\n  map = " << c.map << "\n  grid = " << m.grid << "\n  domain = " << t.domain
     << "\n  address = " << t.address << "\n  discovery_port = " << t.discovery_port << "\n  data_port = " << t.data_port
     << "\n  bandwidth_kbps = " << t.bandwidth_kbps << "\n  output_dir = " << c.output_dir
     << "\n  log_level = " << levels[static_cast<int>(c.log_level)] << "\n  claim_timeout_s = " << c.claim_timeout_s
-    << "\n  request_interval_s = " << c.request_interval_s;
+    << "\n  request_interval_s = " << c.request_interval_s << "\n  match.max_features = " << m.features.max_features
+    << "\n  match.fast_threshold = " << m.features.fast_threshold
+    << "\n  match.ransac_threshold_cells = " << m.ransac_threshold_cells
+    << "\n  match.ransac_iterations = " << m.ransac_iterations << "\n  match.ransac_confidence = " << m.ransac_confidence
+    << "\n  match.min_matches = " << m.min_matches
+    << "\n  match.consensus_translation_cells = " << m.consensus_translation_cells
+    << "\n  match.consensus_yaw_deg = " << degrees(m.consensus_yaw) << "\n  match.min_support = " << m.min_support
+    << "\n  match.min_inliers = " << m.min_inliers << "\n  match.threads = " << m.threads;
   for (const auto& p : t.peers) o << "\n  peer " << p.id << " = " << p.host << ":" << p.port;
   return o.str();
 }

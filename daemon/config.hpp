@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "core/matcher.hpp"
 #include "transport/participant.hpp"
 
 namespace tomomap::daemon {
@@ -13,7 +14,7 @@ struct Config {
   std::string file;                  ///< where it was read from
   transport::TransportConfig transport;  ///< agent id, domain, address, ports, peers, bandwidth
   std::string map;                   ///< own map file (absolute, or relative to the config file)
-  double grid = 0.05;                ///< [m]
+  MatchParams match;                 ///< `grid` and the [match] table; the defaults are MatchParams'
   std::string output_dir;            ///< transforms.json, status.json
   LogLevel log_level = LogLevel::Info;
   double claim_timeout_s = 30;       ///< a claim without a result is void after this [s]

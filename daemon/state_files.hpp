@@ -6,15 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "tomomap.h"
-
 namespace tomomap::daemon {
 
 void writeJsonAtomically(const std::string& path, const nlohmann::json& j);
-
-nlohmann::json toJson(const wire::TransformEstimate& e);
-
-/// Hex form of a map version, as logged and stored.
-std::string versionText(uint64_t version);
 
 }  // namespace tomomap::daemon

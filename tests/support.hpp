@@ -8,7 +8,7 @@
 #include <random>
 #include <string>
 
-#include "core/map_io.hpp"
+#include "io/map_io.hpp"
 
 namespace tomomap::test {
 

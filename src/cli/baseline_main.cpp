@@ -3,7 +3,7 @@
 // stack neither slows down nor inflates the memory of `tomomap` itself, and so
 // that evaluations measure each method's memory on its own.
 #include "baseline/fpfh_ransac.hpp"
-#include "core/map_io.hpp"
+#include "io/map_io.hpp"
 #include "report.hpp"
 #include "run_guarded.hpp"
 #include "version.hpp"

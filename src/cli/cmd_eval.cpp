@@ -164,7 +164,7 @@ cv::Mat boxPlots(const std::vector<Row>& rows, const std::vector<std::string>& m
   for (const auto& r : rows) {
     const std::pair<std::string, std::string> key{r.noise, r.method};
     t.values[key].push_back(r.translation_error / r.grid);
-    y.values[key].push_back(r.yaw_error * 180.0 / kPi);
+    y.values[key].push_back(degrees(r.yaw_error));
     w.values[key].push_back(r.seconds);
     m.values[key].push_back(r.peak_rss_mb);
   }

@@ -104,7 +104,7 @@ void printHuman(const json& status, const json& transforms, bool running) {
     if (t.value("reliable", false)) {
       const json& T = t["T_target_source"];
       std::cout << "x " << fixed(T["x"], 3) << "  y " << fixed(T["y"], 3) << "  z " << fixed(T["z"], 3) << "  yaw "
-                << fixed(T["yaw"].get<double>() * 180 / M_PI, 2) << " deg";
+                << fixed(degrees(T["yaw"].get<double>()), 2) << " deg";
     } else {
       std::cout << "no reliable match: " << t.value("reason", "");
     }

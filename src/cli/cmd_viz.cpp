@@ -33,12 +33,12 @@ int runViz(const VizOptions& o) {
       fs::path(o.files.source).filename().string() + " aligned onto " + fs::path(o.files.target).filename().string() +
           " (walls and other vertical structure, seen from above)",
       "T_target_source: x " + fixed(T.x, 3) + " m, y " + fixed(T.y, 3) + " m, z " + fixed(T.z, 3) + " m, yaw " +
-          fixed(T.yaw * 180 / kPi, 2) + " deg;  support " + std::to_string(r.support) + " slice pairs, " +
+          fixed(degrees(T.yaw), 2) + " deg;  support " + std::to_string(r.support) + " slice pairs, " +
           std::to_string(r.inliers) + " inliers"};
   if (!r.reliable) caption.push_back("NO RELIABLE MATCH (" + r.reason + "): showing the best candidate");
   if (gt)
     caption.push_back("against ground truth: " + fixed(gt->error.translation, 3) + " m, " +
-                      fixed(gt->error.yaw * 180 / kPi, 3) + " deg (" + (gt->success() ? "success" : "FAILURE") + ")");
+                      fixed(degrees(gt->error.yaw), 3) + " deg (" + (gt->success() ? "success" : "FAILURE") + ")");
 
   const std::string overlay = (fs::path(o.out) / "overlay.png").string();
   const std::string slices = (fs::path(o.out) / "slice-pairs.png").string();

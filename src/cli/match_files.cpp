@@ -3,7 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
-#include "core/map_io.hpp"
+#include "io/map_io.hpp"
 #include "progress.hpp"
 
 namespace tomomap::cli {

@@ -31,7 +31,7 @@ GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const Eigen::Matr
   c.expected = Pose4::fromMatrix(P_target * P_source.inverse());
   c.error = poseError(r.T_target_source, c.expected);
   c.translation_limit = 5.0 * grid;
-  c.yaw_limit = 10.0 * kPi / 180.0;
+  c.yaw_limit = radians(10.0);
   return c;
 }
 
@@ -39,7 +39,7 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
   const auto& T = r.T_target_source;
   if (r.reliable) {
     out << format("T_target_source  x %.4f  y %.4f  z %.4f m  yaw %.4f rad (%.2f deg)\n", T.x, T.y, T.z, T.yaw,
-                  T.yaw * 180.0 / kPi);
+                  degrees(T.yaw));
     const Eigen::Matrix4d M = T.matrix();
     for (int i = 0; i < 4; ++i) out << format("  [%9.5f %9.5f %9.5f %9.4f]\n", M(i, 0), M(i, 1), M(i, 2), M(i, 3));
   } else {

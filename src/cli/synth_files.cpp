@@ -4,7 +4,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/map_io.hpp"
+#include "io/map_io.hpp"
 
 namespace tomomap::cli {
 

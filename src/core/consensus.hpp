@@ -6,7 +6,7 @@ namespace tomomap {
 
 struct ConsensusParams {
   double translation_tolerance = 0.25;  ///< [m]; the matcher sets 5 x grid
-  double yaw_tolerance = 10.0 * kPi / 180.0;  ///< [rad]
+  double yaw_tolerance = radians(10.0);  ///< [rad]
 };
 
 struct Consensus {

@@ -9,7 +9,7 @@
 
 #include "dense_refine.hpp"
 #include "hamming.hpp"
-#include "map_io.hpp"
+#include "map_check.hpp"
 #include "voxel_filter.hpp"
 
 namespace tomomap {

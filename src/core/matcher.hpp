@@ -17,7 +17,7 @@ struct MatchParams {
   double ransac_confidence = 0.999;
   int min_matches = 5;                 ///< fewer mutual matches: the slice pair gives no estimate
   double consensus_translation_cells = 5.0;      ///< [grid cells]
-  double consensus_yaw = 10.0 * kPi / 180.0;     ///< [rad]
+  double consensus_yaw = radians(10.0); ///< [rad]
   int min_support = 3;                 ///< agreeing slice pairs needed for a reliable match
   int min_inliers = 20;                ///< inlier correspondences needed for a reliable match
   int threads = 0;                     ///< 0 = all cores

@@ -20,6 +20,10 @@ struct InputError : std::runtime_error {
 
 constexpr double kPi = 3.14159265358979323846;
 
+/// Angle unit conversions: radians inside, degrees where people read or write.
+constexpr double degrees(double radians) { return radians * 180.0 / kPi; }
+constexpr double radians(double degrees) { return degrees * kPi / 180.0; }
+
 /// Wraps an angle into (-pi, pi].
 inline double wrapAngle(double a) {
   a = std::fmod(a + kPi, 2.0 * kPi);

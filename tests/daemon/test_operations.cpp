@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "core/map_io.hpp"
+#include "io/map_io.hpp"
 #include "fleet.hpp"
 
 using namespace tomomap;

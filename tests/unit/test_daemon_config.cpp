@@ -36,7 +36,8 @@ TEST(DaemonConfig, MinimalConfigGetsDefaults) {
   EXPECT_EQ(c.agent(), "alpha");
   EXPECT_EQ(c.map, dir / "maps/a.pcd");  // relative to the config file
   EXPECT_EQ(c.transport.data_port, 17501);
-  EXPECT_DOUBLE_EQ(c.grid, 0.05);
+  EXPECT_DOUBLE_EQ(c.match.grid, MatchParams{}.grid);
+  EXPECT_EQ(c.match.min_support, MatchParams{}.min_support);
   EXPECT_DOUBLE_EQ(c.transport.bandwidth_kbps, 10000);
   ASSERT_EQ(c.transport.peers.size(), 1u);
   EXPECT_TRUE(c.isPeer("bravo"));
@@ -62,12 +63,36 @@ TEST(DaemonConfig, ErrorsNameFileLineAndKey) {
   EXPECT_NE(e.find("'agent' is required"), std::string::npos) << e;
 }
 
+TEST(DaemonConfig, TheMatchTableOverridesTheMatchersDefaults) {
+  TempDir dir;
+  const std::string base = "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\ngrid = 0.1\n";
+  std::ofstream(dir / "c.toml") << base << "[match]\nmin_support = 5\nconsensus_yaw_deg = 5\nthreads = 1\n"
+                                << "max_features = 500\n";
+  const Config c = loadConfig(dir / "c.toml");
+  EXPECT_DOUBLE_EQ(c.match.grid, 0.1);
+  EXPECT_EQ(c.match.min_support, 5);
+  EXPECT_NEAR(c.match.consensus_yaw, radians(5), 1e-12);
+  EXPECT_EQ(c.match.threads, 1);
+  EXPECT_EQ(c.match.features.max_features, 500);
+  EXPECT_EQ(c.match.min_inliers, MatchParams{}.min_inliers) << "keys not given keep the default";
+  EXPECT_NE(describe(c).find("match.min_support = 5"), std::string::npos) << describe(c);
+
+  std::string e = errorOf(dir, base + "[match]\nmin_support = 2.5\n");
+  EXPECT_NE(e.find("c.toml:6:"), std::string::npos) << e;
+  EXPECT_NE(e.find("'min_support': must be a whole number"), std::string::npos) << e;
+  e = errorOf(dir, base + "[match]\nransac = 3\n");
+  EXPECT_NE(e.find("'match.ransac': unknown key"), std::string::npos) << e;
+  e = errorOf(dir, base + "match = 3\n");
+  EXPECT_NE(e.find("must be a table"), std::string::npos) << e;
+}
+
 TEST(DaemonConfig, EveryKeyIsInTheReference) {
   std::ifstream in(std::string(TOMOMAP_SOURCE_DIR) + "/docs/configuration.md");
   const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_FALSE(doc.empty());
   for (std::string key : configKeys()) {
-    if (key.rfind("peer.", 0) == 0) key = key.substr(5);
+    for (const std::string table : {"peer.", "match."})
+      if (key.rfind(table, 0) == 0) key = key.substr(table.size());
     EXPECT_NE(doc.find("`" + key + "`"), std::string::npos) << key << " is not in docs/configuration.md";
   }
 }
@@ -76,12 +101,13 @@ TEST(DaemonConfig, EveryKeyInTheReferenceIsOneTheDaemonReads) {
   std::ifstream in(std::string(TOMOMAP_SOURCE_DIR) + "/docs/configuration.md");
   std::string line;
   size_t rows = 0;
-  const std::regex row(R"(^\| (`\[\[peer\]\]` )?`([a-z_]+)` \|)");
+  const std::regex row(R"(^\| (`\[\[peer\]\]` |`\[match\]` )?`([a-z_]+)` \|)");
   while (std::getline(in, line)) {
     std::smatch m;
     if (!std::regex_search(line, m, row)) continue;
     ++rows;
-    const std::string key = (m[1].matched ? "peer." : "") + m[2].str();
+    const std::string table = !m[1].matched ? "" : m[1].str().find("peer") != std::string::npos ? "peer." : "match.";
+    const std::string key = table + m[2].str();
     const auto& keys = configKeys();
     EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end()) << key << " is documented but not read";
   }

@@ -2,7 +2,7 @@
 
 #include <fstream>
 
-#include "core/map_io.hpp"
+#include "io/map_io.hpp"
 #include "support.hpp"
 
 using namespace tomomap;

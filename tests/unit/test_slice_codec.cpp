@@ -8,7 +8,9 @@
 #include "support.hpp"
 #include "synth/synth.hpp"
 #include "transport/participant.hpp"
-#include "transport/slice_codec.hpp"
+#include "transport/map_offer.hpp"
+#include "transport/reassembler.hpp"
+#include "transport/wire_sizes.hpp"
 
 using namespace tomomap;
 using namespace tomomap::transport;
@@ -43,7 +45,7 @@ Reassembler receiveAll(const MapOffer& offer, bool shuffle) {
   std::vector<wire::SliceFeatures> all;
   for (const auto& [k, samples] : offer.samples) all.insert(all.end(), samples.begin(), samples.end());
   if (shuffle) std::shuffle(all.begin(), all.end(), std::mt19937(7));
-  for (const auto& s : all) EXPECT_EQ(r.accept(s), "");
+  for (const auto& s : all) EXPECT_FALSE(r.accept(s)) << r.accept(s).text();
   return r;
 }
 
@@ -51,11 +53,11 @@ Reassembler receiveAll(const MapOffer& offer, bool shuffle) {
 
 TEST(SliceCodec, RoundTripGivesTheSameFeaturesInAnyOrder) {
   const MapFeatures& f = sampleMap();
-  const MapOffer offer = makeOffer("alpha", f, 1000000, 4000);
-  EXPECT_EQ(validate(offer.announcement), "");
+  const MapOffer offer = makeOffer("alpha", f, {}, 1000000, 4000);
+  EXPECT_FALSE(validate(offer.announcement)) << validate(offer.announcement).text();
   const Reassembler r = receiveAll(offer, /*shuffle=*/true);
   ASSERT_TRUE(r.complete());
-  const MapFeatures back = r.build({});
+  const MapFeatures back = r.build();
   ASSERT_EQ(back.slices.size(), f.slices.size());
   for (size_t i = 0; i < f.slices.size(); ++i) {
     EXPECT_EQ(back.slices[i].index, f.slices[i].index);
@@ -75,7 +77,7 @@ TEST(SliceCodec, SamplesFitTheBudgetAndTheCheaperEncodingIsChosen) {
   const MapFeatures& f = sampleMap();
   const size_t budget = maxSampleBytes(1000);  // 1 Mbit/s
   EXPECT_LE(budget, bytesPerPeriod(1000));
-  const MapOffer offer = makeOffer("alpha", f, 1000000, budget);
+  const MapOffer offer = makeOffer("alpha", f, {}, 1000000, budget);
   size_t features = 0, occupancy = 0;
   for (const auto& [k, samples] : offer.samples)
     for (const auto& s : samples) {
@@ -83,57 +85,61 @@ TEST(SliceCodec, SamplesFitTheBudgetAndTheCheaperEncodingIsChosen) {
       (s.encoding() == wire::SliceEncoding::OCCUPANCY ? occupancy : features)++;
     }
   EXPECT_GT(occupancy + features, 0u);
-  size_t feature_bytes = 36 * f.featureCount();
+  size_t feature_bytes = kFeatureBytes * f.featureCount();
   EXPECT_LE(offer.payload_bytes, feature_bytes) << "never more than sending every feature";
 }
 
 TEST(SliceCodec, InconsistentSamplesAreRejectedNotCrashed) {
-  const MapOffer offer = makeOffer("alpha", sampleMap(), 1000000, 4000);
+  const MapOffer offer = makeOffer("alpha", sampleMap(), {}, 1000000, 4000);
   Reassembler r(offer.announcement);
   wire::SliceFeatures s = offer.samples.begin()->second.front();
 
   wire::SliceFeatures unknown = s;
   unknown.slice(100000);
-  EXPECT_NE(r.accept(unknown), "");
+  EXPECT_EQ(r.accept(unknown), Reject::NotAnnounced);
+  EXPECT_EQ(r.accept(unknown).text(), "slice 100000 was not announced");
   wire::SliceFeatures parts = s;
   parts.parts(static_cast<uint16_t>(parts.parts() + 1));
-  EXPECT_NE(r.accept(parts), "");
+  EXPECT_EQ(r.accept(parts), Reject::PartNumbering);
   wire::SliceFeatures mixed = s;
   mixed.features().resize(1);
   mixed.occupancy({1, 2, 3});
-  EXPECT_NE(r.accept(mixed), "");
+  EXPECT_EQ(r.accept(mixed), Reject::MixedEncoding);
 
   // A corrupted payload is caught by the CRC once the slice is whole.
   wire::SliceFeatures corrupt = s;
   if (!corrupt.features().empty()) corrupt.features()[0].descriptor()[0] ^= 0xff;
   if (!corrupt.occupancy().empty()) corrupt.occupancy()[corrupt.occupancy().size() / 2] ^= 0x5a;
-  std::string verdict;
+  Rejection verdict;
   for (uint16_t p = 0; p < s.parts(); ++p) {
     wire::SliceFeatures x = p == s.part() ? corrupt : offer.samples.begin()->second[p];
     verdict = r.accept(x);
   }
-  EXPECT_NE(verdict, "");
+  EXPECT_EQ(verdict, Reject::ChecksumMismatch);
   EXPECT_FALSE(r.complete());
   EXPECT_EQ(r.missing().size(), offer.announcement.slices().size());
 
   // Announcements that lie are refused before anything is allocated.
   wire::MapAnnouncement a = offer.announcement;
   a.grid(std::nan(""));
-  EXPECT_NE(validate(a), "");
+  EXPECT_EQ(validate(a), Reject::BadGridOrOrigin);
   a = offer.announcement;
   a.width(0);
-  EXPECT_NE(validate(a), "");
+  EXPECT_EQ(validate(a), Reject::BadRaster);
   a = offer.announcement;
   a.version(a.version() + 1);
-  EXPECT_NE(validate(a), "");
+  EXPECT_EQ(validate(a), Reject::VersionMismatch);
+  a = offer.announcement;
+  a.features().max_features(0);
+  EXPECT_EQ(validate(a), Reject::BadFeatureSettings);
 }
 
 TEST(SliceCodec, AMapUpdateReusesTheSlicesThatDidNotChange) {
   // The robot's map gains a cabinet, inside its bounds.
   const Points updated = tomomap::test::withCabinet(samplePoints());
-  const MapOffer before = makeOffer("alpha", sampleMap(), 1000000, 4000);
+  const MapOffer before = makeOffer("alpha", sampleMap(), {}, 1000000, 4000);
   const MapFeatures changed = describeAtDecimetre(updated);
-  const MapOffer after = makeOffer("alpha", changed, 1000000, 4000);
+  const MapOffer after = makeOffer("alpha", changed, {}, 1000000, 4000);
   ASSERT_NE(before.announcement.version(), after.announcement.version());
 
   const Reassembler old = receiveAll(before, false);
@@ -143,16 +149,16 @@ TEST(SliceCodec, AMapUpdateReusesTheSlicesThatDidNotChange) {
   const auto missing = next.missing();
   ASSERT_FALSE(missing.empty()) << "the slices with the cabinet changed";
   for (int32_t k : missing)
-    for (const auto& s : after.samples.at(k)) EXPECT_EQ(next.accept(s), "");
+    for (const auto& s : after.samples.at(k)) EXPECT_FALSE(next.accept(s));
   ASSERT_TRUE(next.complete());
-  const MapFeatures back = next.build({});
+  const MapFeatures back = next.build();
   ASSERT_EQ(back.slices.size(), changed.slices.size());
   for (size_t i = 0; i < back.slices.size(); ++i)
     EXPECT_EQ(cv::norm(back.slices[i].descriptors, changed.slices[i].descriptors, cv::NORM_HAMMING), 0);
 
   // The same map cut for another bandwidth budget is another version: a peer
   // must never combine parts of two chunkings.
-  const MapOffer rechunked = makeOffer("alpha", changed, 1000000, 600);
+  const MapOffer rechunked = makeOffer("alpha", changed, {}, 1000000, 600);
   bool parts_differ = false;
   for (const auto& [k, samples] : after.samples) parts_differ |= samples.size() != rechunked.samples.at(k).size();
   ASSERT_TRUE(parts_differ);
@@ -163,4 +169,29 @@ TEST(SliceCodec, AMapUpdateReusesTheSlicesThatDidNotChange) {
   other.agent("bravo");
   Reassembler stranger(other);
   EXPECT_EQ(stranger.adopt(old), 0u);
+}
+
+TEST(SliceCodec, TheReceiverRunsOrbWithTheAnnouncedSettings) {
+  // An owner that keeps fewer features per slice than the default: the slices
+  // that travel as occupancy must come out of the receiver's ORB the same.
+  FeatureParams few;
+  few.max_features = 200;
+  few.fast_threshold = 30;
+  SliceStack stack = sampleMap().occupancy;
+  const MapFeatures owner = extractFeatures(stack, few);
+  const MapOffer offer = makeOffer("alpha", owner, few, 1000000, 4000);
+  EXPECT_EQ(featureParamsOf(offer.announcement).max_features, 200);
+  EXPECT_EQ(featureParamsOf(offer.announcement).fast_threshold, 30);
+  const MapFeatures back = receiveAll(offer, false).build();
+  ASSERT_EQ(back.slices.size(), owner.slices.size());
+  size_t fewer = 0;  // slices where the settings made a difference
+  for (size_t i = 0; i < back.slices.size(); ++i) {
+    ASSERT_EQ(back.slices[i].keypoints.size(), owner.slices[i].keypoints.size());
+    EXPECT_EQ(cv::norm(back.slices[i].descriptors, owner.slices[i].descriptors, cv::NORM_HAMMING), 0);
+    fewer += owner.slices[i].keypoints.size() < sampleMap().slices[i].keypoints.size();
+  }
+  EXPECT_GT(fewer, 0u) << "the default settings would have given other features";
+  // The settings are part of the version: the same map described otherwise is another map.
+  const MapOffer usual = makeOffer("alpha", sampleMap(), {}, 1000000, 4000);
+  EXPECT_NE(usual.announcement.version(), offer.announcement.version());
 }

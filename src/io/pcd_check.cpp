@@ -8,7 +8,7 @@
 #include <sstream>
 #include <vector>
 
-#include "types.hpp"
+#include "core/types.hpp"
 
 namespace tomomap {
 namespace {

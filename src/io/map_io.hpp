@@ -1,21 +1,22 @@
 #pragma once
-// Reading and writing map files: the only file I/O the core does.
+// Reading and writing map and pose files: the only place that links PCL's io.
 #include <string>
 
-#include "types.hpp"
+#include "core/map_check.hpp"
+#include "core/types.hpp"
 
 namespace tomomap {
 
-/// Smallest map the matcher accepts: below this there is nothing to slice.
-constexpr size_t kMinMapPoints = 100;
+/// Bytes of a binary PCD of `points` x y z floats (header included): what
+/// shipping the raw map would cost, the yardstick for every payload figure.
+constexpr size_t kPcdBytesPerPoint = 3 * sizeof(float);
+constexpr size_t kPcdHeaderBytes = 190;
+constexpr uint64_t binaryPcdBytes(size_t points) { return kPcdBytesPerPoint * points + kPcdHeaderBytes; }
 
 /// Loads a map: .pcd (ascii, binary, binary_compressed), .ply, or .xyz/.txt
 /// (one "x y z" per line, '#' comments). Throws InputError naming the file and
 /// the problem for a missing, unreadable, corrupt, empty or non-finite map.
 Points loadMap(const std::string& path);
-
-/// Checks points the way loadMap does; `what` names the source in messages.
-void validateMap(const Points& points, const std::string& what);
 
 /// Writes a binary_compressed PCD (x y z float). Throws InputError on failure.
 void savePcd(const std::string& path, const Points& points);

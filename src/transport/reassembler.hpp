@@ -1,47 +1,21 @@
 #pragma once
-// A map's slices as wire samples and back: encoding (features or occupancy
-// runs, whichever is smaller), chunking to a sample budget, and reassembly with
-// validation. Pure code on the generated wire types: no participant needed.
+// One peer's map at one version, collected from samples in any order and
+// checked against its announcement.
 #include <map>
 #include <optional>
-#include <set>
-#include <string>
 #include <vector>
 
 #include "core/features.hpp"
+#include "rejection.hpp"
 #include "tomomap.h"
 
 namespace tomomap::transport {
 
-/// What one agent offers: the announcement and every sample of every slice.
-struct MapOffer {
-  wire::MapAnnouncement announcement;
-  std::map<int, std::vector<wire::SliceFeatures>> samples;  ///< by slice index, parts in order
-  size_t payload_bytes = 0;  ///< sum of the slices' payload bytes
-};
-
-/// Slices `features` (its occupancy must be present) into samples of at most
-/// `max_sample_bytes` each. `raw_bytes` is the binary PCD size of the
-/// voxel-filtered map, announced for the record. Most informative slices
-/// (most features) first.
-MapOffer makeOffer(const std::string& agent, const MapFeatures& features, uint64_t raw_bytes,
-                   size_t max_sample_bytes);
-
-/// Hash of a map's description and its chunking: equal maps cut for equal
-/// budgets have equal versions.
-uint64_t mapVersion(const wire::MapAnnouncement& a);
-
-/// Why an announcement or sample was rejected; empty when accepted.
-using Rejection = std::string;
-
-/// Checks an announcement before anything is allocated for it.
-Rejection validate(const wire::MapAnnouncement& a);
-
-/// Collects one peer's map at one version from samples in any order.
 /// Memory is bounded by the announcement: no part that was not announced is
 /// kept, no slice may exceed its announced size.
 class Reassembler {
  public:
+  /// `announcement` must have passed validate().
   explicit Reassembler(wire::MapAnnouncement announcement);
 
   const wire::MapAnnouncement& announcement() const { return announcement_; }
@@ -54,9 +28,9 @@ class Reassembler {
   size_t sliceCount() const { return announcement_.slices().size(); }
   size_t slicesDone() const { return done_.size(); }
   size_t bytesReceived() const { return bytes_received_; }
-  /// The map's features, as the owner computed them (ORB is run here on slices
-  /// that came as occupancy). Only when complete().
-  MapFeatures build(const FeatureParams& params) const;
+  /// The map's features as the owner computed them: ORB runs here, with the
+  /// announced settings, on the slices that came as occupancy. Only when complete().
+  MapFeatures build() const;
   /// Takes over the verified slices of an earlier version of the same agent's
   /// map that this version announces unchanged (same raster, same index, size
   /// and CRC), so that a map update costs only the slices that changed.

@@ -1,0 +1,61 @@
+#pragma once
+// Sending this agent's map: which slices peers asked for, in what order, and
+// when each will have left the flow controller, so that a request for a slice
+// still on its way does not send it again. Pure: the publish call and the
+// time are passed in.
+#include <chrono>
+#include <deque>
+#include <functional>
+#include <map>
+#include <set>
+
+#include "clock.hpp"
+#include "transport/map_offer.hpp"
+
+namespace tomomap::daemon {
+
+
+
+class MapSender {
+ public:
+  /// `bandwidth_kbps`: the flow controller's budget; `grace`: how long after a
+  /// slice's expected departure a request for it is still taken as crossed.
+  MapSender(double bandwidth_kbps, Clock::duration grace);
+  void setBudget(double bandwidth_kbps, Clock::duration grace);
+
+  /// A new map to offer: what was queued belongs to the old version and is
+  /// dropped (peers ask again for what they need).
+  void setOffer(transport::MapOffer offer);
+  const transport::MapOffer& offer() const { return offer_; }
+  uint64_t version() const { return offer_.announcement.version(); }
+
+  /// A peer asked for `slices` (every announced slice when empty) of `version`.
+  /// Queues those not queued and not still on their way; returns how many of
+  /// them this map has (0 for another version: the announcement tells them).
+  size_t request(uint64_t version, const std::vector<int32_t>& slices, Clock::time_point now);
+
+  /// Hands queued parts to `publish` in order until it refuses one (the
+  /// writer's queue is full: the rest goes on a later call). `size` gives a
+  /// sample's bytes on the wire.
+  void pump(const std::function<bool(const wire::SliceFeatures&)>& publish,
+            const std::function<size_t(const wire::SliceFeatures&)>& size, Clock::time_point now);
+
+  size_t queued() const { return queue_.size(); }
+  size_t bytesSent() const { return bytes_sent_; }
+  size_t samplesSent() const { return samples_sent_; }
+
+ private:
+  double kbps_;
+  Clock::duration grace_;
+  transport::MapOffer offer_;
+  std::deque<int> queue_;  ///< slices to send, in order
+  std::set<int> queued_;
+  size_t next_part_ = 0;   ///< part of queue_.front() to send next
+  /// When the flow controller will have sent everything handed to it so far,
+  /// and when each slice's last copy leaves.
+  Clock::time_point backlog_until_{};
+  std::map<int, Clock::time_point> leaves_at_;
+  size_t bytes_sent_ = 0, samples_sent_ = 0;
+};
+
+}  // namespace tomomap::daemon

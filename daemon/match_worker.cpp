@@ -1,0 +1,58 @@
+#include "match_worker.hpp"
+
+#include "clock.hpp"
+
+namespace tomomap::daemon {
+
+MatchWorker::~MatchWorker() {
+  if (thread_.joinable()) thread_.join();
+}
+
+AgreedTransform agreedFromMatch(const PairAt& pair, const MatchResult& r, const std::string& me) {
+  AgreedTransform t;
+  t.target = pair.pair.first;
+  t.source = pair.pair.second;
+  t.target_version = pair.target_version;
+  t.source_version = pair.source_version;
+  t.computed_by = me;
+  t.reliable = r.reliable;
+  t.reason = r.reason;
+  t.T_target_source = r.T_target_source;
+  t.support = r.support;
+  t.runner_up_support = r.runner_up_support;
+  t.inliers = static_cast<uint32_t>(r.inliers);
+  t.spread = {r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z()};
+  return t;
+}
+
+void MatchWorker::start(const PairAt& pair, std::shared_ptr<const MapFeatures> target,
+                        std::shared_ptr<const MapFeatures> source, const MatchParams& params, const std::string& me) {
+  done_ = false;
+  thread_ = std::thread([this, pair, target = std::move(target), source = std::move(source), params, me] {
+    const auto t0 = Clock::now();
+    AgreedTransform t;
+    try {
+      t = agreedFromMatch(pair, matchFeatures(*target, *source, params), me);
+    } catch (const std::exception& ex) {
+      t = agreedFromMatch(pair, MatchResult{}, me);
+      t.reason = ex.what();
+    }
+    t.computed_at_ms = wallMs();
+    t.seconds = seconds(Clock::now() - t0);
+    result_ = std::move(t);
+    done_ = true;
+    wake_();
+  });
+}
+
+AgreedTransform MatchWorker::take() {
+  thread_.join();
+  done_ = false;
+  return std::move(result_);
+}
+
+void MatchWorker::abandon() {
+  if (thread_.joinable() && !done_) thread_.detach();
+}
+
+}  // namespace tomomap::daemon

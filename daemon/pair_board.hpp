@@ -1,0 +1,133 @@
+#pragma once
+// Who computes which pair, and what the fleet agreed: one state per pair of
+// agents, driven by the maps this agent holds, by claims and estimates from
+// the network and by its own decisions. Pure: no DDS, no threads, no clock of
+// its own (the time is passed in), so races can be replayed in unit tests.
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "clock.hpp"
+#include "results/agreed_transform.hpp"
+
+namespace tomomap::daemon {
+
+
+
+/// The tie-break, written once: of two agents that claim, or computed, the
+/// same pair at the same versions, the one with the lower id wins.
+inline bool outranks(const std::string& a, const std::string& b) { return a < b; }
+
+/// A pair at the versions of its two maps.
+struct PairAt {
+  PairKey pair;
+  uint64_t target_version = 0, source_version = 0;
+};
+
+enum class PairState {
+  WaitingForMaps,  ///< this agent does not hold both maps at their announced versions
+  Open,            ///< both maps held, nobody on it yet
+  ClaimedByPeer,   ///< another agent's live claim for these versions
+  Claimed,         ///< our claim, waiting for competing claims to show up
+  Computing,       ///< our worker is matching it
+  Agreed,          ///< a result for the current versions
+  Stale,           ///< a result for earlier versions, and nobody on the new ones yet
+};
+const char* stateName(PairState s);
+
+struct PairStatus {
+  PairState state = PairState::WaitingForMaps;
+  std::string by;  ///< the claimer (ClaimedByPeer) or the computing agent (Agreed, Stale)
+};
+
+struct BoardTimings {
+  Clock::duration claim_timeout{};  ///< a claim without a result is void after this (config: claim_timeout_s)
+  Clock::duration claim_settle = std::chrono::milliseconds(500);  ///< time for competing claims to show up
+};
+
+/// What this agent is to do now.
+struct BoardStep {
+  std::vector<PairAt> claims;     ///< publish a claim for each
+  std::vector<std::string> yielded;  ///< "pair to claimer", for the log
+  std::optional<PairAt> compute;  ///< start matching this pair
+};
+
+class PairBoard {
+ public:
+  PairBoard(std::string me, BoardTimings timings);
+  void setTimings(BoardTimings t) { timings_ = t; }
+
+  // ---- what this agent knows of each map
+  /// `agent` announced `version` (not yet held, unless it is ours).
+  void mapAnnounced(const std::string& agent, uint64_t version);
+  /// This agent now holds `agent`'s map at its announced version.
+  void mapHeld(const std::string& agent);
+  /// Our own map has a new version: our claims made with the old one are void.
+  void ownMap(uint64_t version);
+  /// Forgets the maps of every peer `keep` rejects (removed from the config).
+  template <typename Keep>
+  void retainMaps(Keep keep) {
+    for (auto it = maps_.begin(); it != maps_.end();)
+      it = it->first == me_ || keep(it->first) ? std::next(it) : maps_.erase(it);
+  }
+  std::optional<uint64_t> versionOf(const std::string& agent) const;
+
+  // ---- from the network
+  void claimSeen(const std::string& claimer, const PairAt& claim, Clock::time_point now);
+  /// Whether an estimate from the network was stored.
+  enum class Offer { Stored, Duplicate, Outdated };
+  Offer estimateSeen(AgreedTransform t);
+  /// A peer's participant is gone: its claims are void.
+  void agentGone(const std::string& agent);
+  /// This agent left the network (and joins again): every claim is void.
+  void leftNetwork();
+
+  // ---- this agent's decisions
+  /// Claims pairs whose maps are held and that nobody is on; starts computing
+  /// one whose claim has settled and that no higher-ranked claimer contests.
+  /// At most one computation at a time.
+  BoardStep step(Clock::time_point now);
+  /// Our worker's result for the pair being computed: stored (even if the
+  /// versions moved on meanwhile: then the pair is stale and is recomputed).
+  void computed(AgreedTransform t);
+  const std::optional<PairAt>& computing() const { return computing_; }
+
+  // ---- what the fleet agreed
+  const std::map<PairKey, AgreedTransform>& results() const { return results_; }
+  /// Whether `t` was computed for the maps' versions known now.
+  bool isCurrent(const AgreedTransform& t) const;
+  size_t currentResults() const;
+  PairStatus status(const PairKey& pair, Clock::time_point now) const;
+  /// Every pair among the agents whose maps we know (and those with results).
+  std::vector<PairKey> pairs() const;
+
+ private:
+  struct MapState {
+    uint64_t version = 0;
+    bool held = false;
+  };
+  struct Claim {
+    std::string claimer;
+    uint64_t target_version = 0, source_version = 0;
+    Clock::time_point seen;
+  };
+  struct OwnClaim {
+    uint64_t target_version = 0, source_version = 0;
+    Clock::time_point at;
+  };
+  bool live(const Claim& c, const PairAt& at, Clock::time_point now) const;
+  std::optional<PairAt> heldPair(const PairKey& key) const;
+
+  std::string me_;
+  BoardTimings timings_;
+  std::map<std::string, MapState> maps_;
+  std::map<PairKey, Claim> claims_;         ///< the winning claim of other agents per pair
+  std::map<PairKey, OwnClaim> own_claims_;  ///< pairs we claimed, at which versions, when
+  std::optional<PairAt> computing_;
+  std::map<PairKey, AgreedTransform> results_;
+};
+
+}  // namespace tomomap::daemon

@@ -1,0 +1,152 @@
+#include "peer_maps.hpp"
+
+#include "core/text.hpp"
+#include "results/agreed_transform.hpp"
+
+namespace tomomap::daemon {
+namespace {
+
+constexpr size_t kTransfersKept = 8;
+
+}  // namespace
+
+wire::ChunkRequest PeerMaps::requestFor(const std::string& owner, const Peer& p, bool everything) const {
+  wire::ChunkRequest r;
+  r.requester(me_);
+  r.owner(owner);
+  r.version(p.incoming->announcement().version());
+  if (!everything) r.slices(p.incoming->missing());  // else an empty list: everything
+  return r;
+}
+
+PeerMaps::Announced PeerMaps::announce(wire::MapAnnouncement a, Clock::time_point now) {
+  const std::string owner = a.agent().to_string();
+  Peer& p = peers_[owner];
+  if (p.incoming && p.incoming->announcement().version() == a.version()) return {};  // already known
+  std::optional<transport::Reassembler> earlier = std::move(p.incoming);
+  p = Peer{};
+  p.incoming.emplace(std::move(a));
+  // A new version of a map we hold (or held in part): keep the unchanged slices.
+  if (earlier) p.reused = p.incoming->adopt(*earlier);
+  const auto& announced = p.incoming->announcement();
+  log_.info("peer " + owner + " announced map version " + versionText(announced.version()) + ": " +
+            std::to_string(announced.slices().size()) + " slices" +
+            (earlier ? ", " + std::to_string(p.reused) + " of them unchanged from version " +
+                           versionText(earlier->announcement().version())
+                     : ""));
+  p.last_progress = p.requested = p.last_request = now;
+  Announced out{true, false, std::nullopt};
+  if (p.incoming->complete()) {
+    complete(owner, p);
+    out.complete = true;
+  } else {
+    out.request = requestFor(owner, p, /*everything=*/p.reused == 0);
+  }
+  return out;
+}
+
+PeerMaps::Received PeerMaps::receive(const wire::SliceFeatures& s, size_t bytes, Clock::time_point now) {
+  const auto it = peers_.find(s.agent().to_string());
+  if (it == peers_.end() || !it->second.incoming || it->second.incoming->announcement().version() != s.version())
+    return {};  // a version we were not told about (yet) or no longer want
+  Peer& p = it->second;
+  if (p.features) return {};  // complete already: a resend meant for another peer
+  Received out;
+  if ((out.rejection = p.incoming->accept(s))) return out;
+  out.first = p.samples++ == 0;
+  if (out.first) p.first_slice = now;
+  p.bytes += bytes;
+  p.last_slice = p.last_progress = now;
+  if (p.incoming->complete()) {
+    complete(it->first, p);
+    out.completed = true;
+  }
+  return out;
+}
+
+void PeerMaps::complete(const std::string& owner, Peer& p) {
+  p.features = std::make_shared<MapFeatures>(p.incoming->build());
+  const double span = p.samples ? seconds(p.last_slice - p.requested) : 0;
+  auto& history = transfers_[owner];
+  history.push_back({p.incoming->announcement().version(), p.incoming->sliceCount(), p.reused, p.bytes, span});
+  if (history.size() > kTransfersKept) history.pop_front();
+  log_.info("received the map of " + owner + ": " + std::to_string(p.incoming->sliceCount()) + " slices (" +
+            std::to_string(p.reused) + " kept from the previous version), " + std::to_string(p.bytes) + " bytes in " +
+            std::to_string(p.samples) + " samples, " + fixed(span, 2) + " s after our request (" +
+            fixed(rateKbps(p), 0) + " kbit/s while sending)");
+}
+
+std::vector<wire::ChunkRequest> PeerMaps::due(Clock::duration interval, bool at_once, Clock::time_point now) {
+  std::vector<wire::ChunkRequest> out;
+  for (auto& [id, p] : peers_) {
+    if (!p.incoming || p.features) continue;
+    const auto quiet_since = std::max(p.last_progress, p.last_request);
+    if (!at_once && now - quiet_since < interval) continue;
+    out.push_back(requestFor(id, p, /*everything=*/false));
+    p.last_request = now;
+    log_.info("asked " + id + " again for " + std::to_string(out.back().slices().size()) + " missing slices");
+  }
+  return out;
+}
+
+std::shared_ptr<const MapFeatures> PeerMaps::features(const std::string& peer) const {
+  const auto it = peers_.find(peer);
+  return it == peers_.end() ? nullptr : it->second.features;
+}
+
+std::optional<uint64_t> PeerMaps::version(const std::string& peer) const {
+  const auto it = peers_.find(peer);
+  if (it == peers_.end() || !it->second.incoming) return std::nullopt;
+  return it->second.incoming->announcement().version();
+}
+
+bool PeerMaps::setAlive(const std::string& peer, bool alive) {
+  return alive ? alive_.insert(peer).second : alive_.erase(peer) > 0;
+}
+
+PeerMaps::Totals PeerMaps::totals() const {
+  Totals t;
+  for (const auto& [id, p] : peers_) {
+    if (!p.incoming) continue;
+    t.maps += p.features != nullptr;
+    t.slices_done += p.incoming->slicesDone();
+    t.slices_all += p.incoming->sliceCount();
+  }
+  return t;
+}
+
+double PeerMaps::rateKbps(const Peer& p) {
+  if (p.samples < 2) return 0;
+  const double span = seconds(p.last_slice - p.first_slice) + transport::kFlowPeriodMs / 1000.0;
+  return static_cast<double>(p.bytes) * 8 / 1000 / span;
+}
+
+nlohmann::json PeerMaps::status(const transport::PeerAddress& peer) const {
+  nlohmann::json j{{"alive", alive_.count(peer.id) > 0}, {"host", peer.host}, {"port", peer.port}};
+  if (const auto seen = last_seen_ms_.find(peer.id); seen != last_seen_ms_.end()) j["last_seen_ms"] = seen->second;
+  const auto it = peers_.find(peer.id);
+  if (it != peers_.end() && it->second.incoming) {
+    const Peer& p = it->second;
+    j["version"] = versionText(p.incoming->announcement().version());
+    j["slices_received"] = p.incoming->slicesDone();
+    j["slices_total"] = p.incoming->sliceCount();
+    j["slices_reused"] = p.reused;
+    j["bytes_received"] = p.bytes;
+    j["samples_received"] = p.samples;
+    j["complete"] = p.features != nullptr;
+    j["transfer_seconds"] = p.samples ? seconds(p.last_slice - p.requested) : 0.0;
+    j["rate_kbps"] = rateKbps(p);
+  }
+  nlohmann::json history = nlohmann::json::array();
+  if (const auto t = transfers_.find(peer.id); t != transfers_.end())
+    for (const auto& x : t->second)
+      history.push_back({{"version", versionText(x.version)},
+                         {"slices", x.slices},
+                         {"slices_reused", x.reused},
+                         {"bytes", x.bytes},
+                         {"seconds", x.seconds}});
+  j["transfers"] = history;
+  return j;
+}
+
+}  // namespace tomomap::daemon

@@ -1,0 +1,104 @@
+#pragma once
+// The peers' maps as they arrive: one reassembler per peer at its latest
+// announced version, the requests for what is still missing, and the history
+// of finished transfers. No DDS: requests are returned for the caller to send.
+#include <chrono>
+#include <deque>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+
+#include "clock.hpp"
+#include "log.hpp"
+#include "transport/participant.hpp"
+#include "transport/reassembler.hpp"
+
+namespace tomomap::daemon {
+
+
+
+class PeerMaps {
+ public:
+  PeerMaps(std::string me, const Log& log) : me_(std::move(me)), log_(log) {}
+
+  /// What a new announcement led to.
+  struct Announced {
+    bool new_version = false;  ///< false: a version we know already (nothing else happened)
+    bool complete = false;     ///< every slice was kept from the previous version
+    std::optional<wire::ChunkRequest> request;  ///< to send to the owner
+  };
+  /// A validated announcement of a peer's map.
+  Announced announce(wire::MapAnnouncement a, Clock::time_point now);
+
+  struct Received {
+    transport::Rejection rejection;
+    bool completed = false;   ///< this sample completed the map: features() holds it now
+    bool first = false;       ///< the first sample of this version
+  };
+  /// A slice sample from its owner (`bytes` on the wire). Samples of versions
+  /// not (or no longer) wanted, and of maps already complete, are ignored.
+  Received receive(const wire::SliceFeatures& s, size_t bytes, Clock::time_point now);
+
+  /// Requests for the maps still incomplete that have made no progress for
+  /// `interval` (all of them when `at_once`).
+  std::vector<wire::ChunkRequest> due(Clock::duration interval, bool at_once, Clock::time_point now);
+
+  std::shared_ptr<const MapFeatures> features(const std::string& peer) const;
+  /// The latest version `peer` announced, held or not.
+  std::optional<uint64_t> version(const std::string& peer) const;
+
+  /// Discovery: a peer's participant came (true) or went; returns whether that changed anything.
+  bool setAlive(const std::string& peer, bool alive);
+  size_t aliveCount() const { return alive_.size(); }
+  /// A sample from `peer` arrived (wall time, for status).
+  void seen(const std::string& peer, uint64_t wall_ms) { last_seen_ms_[peer] = wall_ms; }
+  /// Drops every peer `keep` rejects (a reload removed it from the config).
+  template <typename Keep>
+  void retain(Keep keep) {
+    for (auto it = peers_.begin(); it != peers_.end();) it = keep(it->first) ? std::next(it) : peers_.erase(it);
+  }
+  void clearAlive() { alive_.clear(); }
+
+  /// Progress over every peer: maps complete, slices received and announced.
+  struct Totals {
+    size_t maps = 0, slices_done = 0, slices_all = 0;
+  };
+  Totals totals() const;
+  /// status.json's entry for one configured peer.
+  nlohmann::json status(const transport::PeerAddress& peer) const;
+
+ private:
+  struct Peer {
+    std::optional<transport::Reassembler> incoming;  ///< the latest announced version
+    std::shared_ptr<const MapFeatures> features;     ///< once complete
+    Clock::time_point last_progress{}, last_request{};
+    Clock::time_point requested{};  ///< when this version was first asked for: the transfer's start
+    Clock::time_point first_slice{}, last_slice{};
+    size_t bytes = 0, samples = 0;
+    size_t reused = 0;  ///< slices kept from the previous version
+  };
+  /// A finished transfer of one version of a peer's map.
+  struct Transfer {
+    uint64_t version = 0;
+    size_t slices = 0, reused = 0, bytes = 0;
+    double seconds = 0;
+  };
+  /// Builds a peer's map once every slice is in, and records the transfer.
+  void complete(const std::string& owner, Peer& p);
+  wire::ChunkRequest requestFor(const std::string& owner, const Peer& p, bool everything) const;
+  /// Transfer rate so far [kbit/s]: bytes over the flow-control periods they
+  /// took (the first period's budget leaves at once, so the time from the first
+  /// to the last sample is one period short).
+  static double rateKbps(const Peer& p);
+
+  std::string me_;
+  const Log& log_;
+  std::map<std::string, Peer> peers_;
+  std::map<std::string, std::deque<Transfer>> transfers_;  ///< finished transfers per peer, latest last
+  std::set<std::string> alive_;
+  std::map<std::string, uint64_t> last_seen_ms_;
+};
+
+}  // namespace tomomap::daemon

@@ -1,0 +1,73 @@
+#include "agreed_transform.hpp"
+
+#include <cstdio>
+
+namespace tomomap {
+
+std::string versionText(uint64_t version) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(version));
+  return buf;
+}
+
+uint64_t parseVersion(const std::string& text) {
+  if (text.empty() || text.size() > 16 || text.find_first_not_of("0123456789abcdefABCDEF") != std::string::npos)
+    throw InputError("'" + text + "' is not a map version (1-16 hex digits)");
+  return std::stoull(text, nullptr, 16);
+}
+
+nlohmann::json toJson(const AgreedTransform& t) {
+  nlohmann::json j{{"target", t.target},
+                   {"source", t.source},
+                   {"target_version", versionText(t.target_version)},
+                   {"source_version", versionText(t.source_version)},
+                   {"reliable", t.reliable},
+                   {"computed_by", t.computed_by},
+                   {"computed_at_ms", t.computed_at_ms},
+                   {"matching_seconds", t.seconds}};
+  if (t.reliable) {
+    const Eigen::Matrix4d M = t.T_target_source.matrix();
+    nlohmann::json m = nlohmann::json::array();
+    for (int r = 0; r < 4; ++r) m.push_back({M(r, 0), M(r, 1), M(r, 2), M(r, 3)});
+    const Pose4& T = t.T_target_source;
+    j["T_target_source"] = {{"x", T.x}, {"y", T.y}, {"z", T.z}, {"yaw", T.yaw}, {"matrix", m}};
+  } else {
+    j["reason"] = t.reason;
+  }
+  j["quality"] = {{"support", t.support},
+                  {"runner_up_support", t.runner_up_support},
+                  {"inliers", t.inliers},
+                  {"inlier_spread", t.spread}};
+  return j;
+}
+
+AgreedTransform agreedFromJson(const nlohmann::json& j) {
+  try {
+    AgreedTransform t;
+    t.target = j.at("target").get<std::string>();
+    t.source = j.at("source").get<std::string>();
+    t.target_version = parseVersion(j.at("target_version").get<std::string>());
+    t.source_version = parseVersion(j.at("source_version").get<std::string>());
+    t.reliable = j.at("reliable").get<bool>();
+    t.computed_by = j.at("computed_by").get<std::string>();
+    t.computed_at_ms = j.at("computed_at_ms").get<uint64_t>();
+    t.seconds = j.at("matching_seconds").get<double>();
+    if (t.reliable) {
+      const auto& T = j.at("T_target_source");
+      t.T_target_source = {T.at("x").get<double>(), T.at("y").get<double>(), T.at("z").get<double>(),
+                           T.at("yaw").get<double>()};
+    } else {
+      t.reason = j.value("reason", "");
+    }
+    const auto& q = j.at("quality");
+    t.support = q.at("support").get<int>();
+    t.runner_up_support = q.at("runner_up_support").get<int>();
+    t.inliers = q.at("inliers").get<uint32_t>();
+    t.spread = q.at("inlier_spread").get<std::array<double, 3>>();
+    return t;
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(std::string("not a stored transform: ") + e.what());
+  }
+}
+
+}  // namespace tomomap

@@ -1,0 +1,51 @@
+#pragma once
+// The transform a fleet agreed for one pair of maps, as tomomapd keeps it and
+// `tomomap status` reads it back: one type, one JSON form (transforms.json).
+// The wire form lives in transport/estimate_wire.hpp.
+#include <array>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+
+#include "core/types.hpp"
+
+namespace tomomap {
+
+/// An ordered pair of agents: target < source by id.
+using PairKey = std::pair<std::string, std::string>;
+
+/// "target<-source", as logged and shown.
+inline std::string pairText(const PairKey& p) { return p.first + "<-" + p.second; }
+
+/// Hex form of a map version, as logged and stored.
+std::string versionText(uint64_t version);
+/// The inverse; throws InputError for anything but 1-16 hex digits.
+uint64_t parseVersion(const std::string& text);
+
+struct AgreedTransform {
+  std::string target, source;
+  uint64_t target_version = 0, source_version = 0;  ///< the maps' versions it was computed for
+  bool reliable = false;             ///< false: computed, no reliable match (T is then meaningless)
+  std::string reason;                ///< why not, when not reliable
+  Pose4 T_target_source;             ///< p_target = T_target_source * p_source
+  int support = 0;                   ///< agreeing slice pairs
+  int runner_up_support = 0;
+  uint32_t inliers = 0;
+  std::array<double, 3> spread{};    ///< std. dev. of the inliers in target x, y, z [m]
+  std::string computed_by;
+  uint64_t computed_at_ms = 0;       ///< the computing agent's wall clock [ms since the epoch]
+  double seconds = 0;                ///< matching time [s]
+
+  PairKey pair() const { return {target, source}; }
+  /// Computed for exactly these versions of the two maps.
+  bool isFor(uint64_t target_v, uint64_t source_v) const {
+    return target_version == target_v && source_version == source_v;
+  }
+};
+
+nlohmann::json toJson(const AgreedTransform& t);
+/// Reads one entry of transforms.json; throws InputError naming what is wrong.
+AgreedTransform agreedFromJson(const nlohmann::json& j);
+
+}  // namespace tomomap

@@ -1,0 +1,176 @@
+#include "map_offer.hpp"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <set>
+
+#include "slice_encoding.hpp"
+
+namespace tomomap::transport {
+namespace {
+
+/// Room a sample's own fields take besides its payload (agent, version, slice,
+/// part numbers, encoding, sequence lengths), with margin.
+constexpr size_t kSampleHeaderBytes = 256;
+/// Feature settings outside these are refused: a receiver would otherwise run
+/// ORB with whatever a peer names.
+constexpr int kMaxFeaturesCap = 10000, kMaxPad = 256;
+
+template <typename T>
+std::vector<std::vector<T>> split(const std::vector<T>& items, size_t per_part) {
+  std::vector<std::vector<T>> parts;
+  for (size_t i = 0; i < items.size(); i += per_part)
+    parts.emplace_back(items.begin() + static_cast<long>(i),
+                       items.begin() + static_cast<long>(std::min(items.size(), i + per_part)));
+  if (parts.empty()) parts.emplace_back();
+  return parts;
+}
+
+/// One slice's samples, in the cheaper encoding.
+std::vector<wire::SliceFeatures> cutSlice(const std::string& agent, const SliceFeatures& s,
+                                          const std::vector<uint32_t>& cells, const SliceGrid& g,
+                                          size_t features_per_part, size_t bytes_per_part) {
+  std::vector<wire::Feature> feats = featuresToWire(s, g);
+  const std::vector<uint8_t> deflated = cells.empty() ? std::vector<uint8_t>{} : deflateCells(cells, g.width, g.height);
+  const bool as_cells = !deflated.empty() && deflated.size() < feats.size() * kFeatureBytes;
+  std::vector<wire::SliceFeatures> samples;
+  auto base = [&](size_t part, size_t parts) {
+    wire::SliceFeatures x;
+    x.agent(agent);
+    x.slice(s.index);
+    x.part(static_cast<uint16_t>(part));
+    x.parts(static_cast<uint16_t>(parts));
+    x.encoding(as_cells ? wire::SliceEncoding::OCCUPANCY : wire::SliceEncoding::FEATURES);
+    return x;
+  };
+  if (as_cells) {
+    const auto parts = split(deflated, bytes_per_part);
+    for (size_t p = 0; p < parts.size(); ++p) samples.push_back(base(p, parts.size())), samples.back().occupancy(parts[p]);
+  } else {
+    const auto parts = split(feats, features_per_part);
+    for (size_t p = 0; p < parts.size(); ++p) samples.push_back(base(p, parts.size())), samples.back().features(parts[p]);
+  }
+  return samples;
+}
+
+}  // namespace
+
+MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const FeatureParams& params, uint64_t raw_bytes,
+                   size_t max_sample_bytes) {
+  const SliceGrid& g = f.occupancy.grid;
+  const size_t room =
+      max_sample_bytes > kSampleHeaderBytes + kFeatureBytes ? max_sample_bytes - kSampleHeaderBytes : kFeatureBytes;
+  const size_t features_per_part = std::clamp<size_t>(room / kFeatureBytes, 1, wire::MAX_FEATURES_PER_SAMPLE);
+  const size_t bytes_per_part = std::clamp<size_t>(room, 1, wire::MAX_OCCUPANCY_PER_SAMPLE);
+
+  MapOffer offer;
+  auto& a = offer.announcement;
+  a.agent(agent);
+  a.grid(f.grid);
+  a.x_min(g.x_min);
+  a.y_min(g.y_min);
+  a.z_min(f.z_min);
+  a.width(static_cast<uint16_t>(g.width));
+  a.height(static_cast<uint16_t>(g.height));
+  a.slice_count(f.slice_count);
+  a.raw_bytes(raw_bytes);
+  a.features().max_features(static_cast<uint16_t>(params.max_features));
+  a.features().fast_threshold(static_cast<uint16_t>(params.fast_threshold));
+  a.features().pad(static_cast<uint16_t>(params.pad));
+
+  // Most informative first: a receiver that gets only part of the map early
+  // holds the slices most likely to match.
+  std::vector<const SliceFeatures*> order;
+  for (const auto& s : f.slices) order.push_back(&s);
+  std::stable_sort(order.begin(), order.end(), [](const SliceFeatures* x, const SliceFeatures* y) {
+    return x->keypoints.size() > y->keypoints.size();
+  });
+  if (order.size() > wire::MAX_SLICES) order.resize(wire::MAX_SLICES);
+
+  for (const SliceFeatures* s : order) {
+    auto samples = cutSlice(agent, *s, f.occupancy.cells.at(static_cast<size_t>(s->index)), g, features_per_part,
+                            bytes_per_part);
+    const auto bytes = canonicalBytes(samples);
+    wire::SliceEntry e;
+    e.slice(s->index);
+    e.parts(static_cast<uint16_t>(samples.size()));
+    e.bytes(static_cast<uint32_t>(bytes.size()));
+    e.crc32(crcOf(bytes));
+    a.slices().push_back(e);
+    offer.payload_bytes += bytes.size();
+    offer.samples[s->index] = std::move(samples);
+  }
+  a.version(mapVersion(a));
+  for (auto& [k, samples] : offer.samples)
+    for (auto& x : samples) x.version(a.version());
+  return offer;
+}
+
+uint64_t mapVersion(const wire::MapAnnouncement& a) {
+  // FNV-1a over the raster geometry, the feature settings and every slice's
+  // index, CRC and part count: the same content cut for another bandwidth
+  // budget (a reload) is another version, so a receiver never mixes parts of
+  // two chunkings.
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](uint64_t v) {
+    for (int i = 0; i < 8; ++i) {
+      h ^= (v >> (8 * i)) & 0xff;
+      h *= 1099511628211ull;
+    }
+  };
+  auto bits = [](double d) {
+    uint64_t u;
+    std::memcpy(&u, &d, sizeof u);
+    return u;
+  };
+  mix(bits(a.grid()));
+  mix(bits(a.x_min()));
+  mix(bits(a.y_min()));
+  mix(bits(a.z_min()));
+  mix((uint64_t{a.width()} << 16) | a.height());
+  const auto& fs = a.features();
+  mix((uint64_t{fs.max_features()} << 32) | (uint64_t{fs.fast_threshold()} << 16) | fs.pad());
+  for (const auto& e : a.slices()) {
+    mix((uint64_t{static_cast<uint32_t>(e.slice())} << 32) | e.crc32());
+    mix(e.parts());
+  }
+  return h;
+}
+
+FeatureParams featureParamsOf(const wire::MapAnnouncement& a) {
+  FeatureParams p;
+  p.max_features = a.features().max_features();
+  p.fast_threshold = a.features().fast_threshold();
+  p.pad = a.features().pad();
+  return p;
+}
+
+Rejection validate(const wire::MapAnnouncement& a) {
+  if (!(a.grid() > 0) || !std::isfinite(a.grid()) || !std::isfinite(a.x_min()) || !std::isfinite(a.y_min()) ||
+      !std::isfinite(a.z_min()))
+    return {Reject::BadGridOrOrigin};
+  if (a.width() == 0 || a.height() == 0 || a.width() > kMaxImageSide || a.height() > kMaxImageSide)
+    return {Reject::BadRaster};
+  if (a.slice_count() <= 0 || a.slice_count() > 100000) return {Reject::BadSliceCount};
+  const auto& fs = a.features();
+  if (fs.max_features() == 0 || fs.max_features() > kMaxFeaturesCap || fs.fast_threshold() == 0 ||
+      fs.fast_threshold() > 255 || fs.pad() > kMaxPad)
+    return {Reject::BadFeatureSettings};
+  // A slice can never need more than its deflated raster or its announced features.
+  const size_t cap = std::max<size_t>(compressBound(static_cast<uLong>(rasterBytes(a.width(), a.height()))),
+                                      size_t{fs.max_features()} * kFeatureBytes);
+  std::set<int> seen;
+  for (const auto& e : a.slices()) {
+    if (e.slice() < 0 || e.slice() >= a.slice_count() || !seen.insert(e.slice()).second)
+      return {Reject::SliceOutOfRange, e.slice()};
+    if (e.parts() == 0 || e.parts() > 1024) return {Reject::BadPartCount, e.slice()};
+    if (e.bytes() > cap) return {Reject::OversizedSlice, e.slice()};
+  }
+  if (a.version() != mapVersion(a)) return {Reject::VersionMismatch};
+  return {};
+}
+
+}  // namespace tomomap::transport

@@ -1,0 +1,38 @@
+#pragma once
+// What one agent offers of its map: the announcement (raster, feature
+// settings, every slice's size and CRC, and a version hashed over all of it)
+// and every slice cut into samples that fit the bandwidth budget.
+#include <map>
+#include <vector>
+
+#include "core/features.hpp"
+#include "rejection.hpp"
+#include "tomomap.h"
+
+namespace tomomap::transport {
+
+struct MapOffer {
+  wire::MapAnnouncement announcement;
+  std::map<int, std::vector<wire::SliceFeatures>> samples;  ///< by slice index, parts in order
+  size_t payload_bytes = 0;  ///< sum of the slices' payload bytes
+};
+
+/// Slices `features` (its occupancy must be present; `params` are the ones it
+/// was extracted with) into samples of at most `max_sample_bytes` each. Each
+/// slice travels as features or as deflated occupancy, whichever is smaller.
+/// `raw_bytes` is the binary PCD size of the voxel-filtered map, announced for
+/// the record. Most informative slices (most features) first.
+MapOffer makeOffer(const std::string& agent, const MapFeatures& features, const FeatureParams& params,
+                   uint64_t raw_bytes, size_t max_sample_bytes);
+
+/// Hash of a map's raster, feature settings, slices and chunking: equal maps
+/// described alike and cut for equal budgets have equal versions.
+uint64_t mapVersion(const wire::MapAnnouncement& a);
+
+/// The feature settings an announcement carries, as the core takes them.
+FeatureParams featureParamsOf(const wire::MapAnnouncement& a);
+
+/// Checks an announcement before anything is allocated for it.
+Rejection validate(const wire::MapAnnouncement& a);
+
+}  // namespace tomomap::transport

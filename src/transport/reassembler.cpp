@@ -1,0 +1,105 @@
+#include "reassembler.hpp"
+
+#include <algorithm>
+
+#include "map_offer.hpp"
+#include "slice_encoding.hpp"
+
+namespace tomomap::transport {
+
+Reassembler::Reassembler(wire::MapAnnouncement announcement) : announcement_(std::move(announcement)) {
+  for (size_t i = 0; i < announcement_.slices().size(); ++i) entries_[announcement_.slices()[i].slice()] = i;
+}
+
+Rejection Reassembler::accept(const wire::SliceFeatures& x) {
+  const auto it = entries_.find(x.slice());
+  if (it == entries_.end()) return {Reject::NotAnnounced, x.slice()};
+  const wire::SliceEntry& e = announcement_.slices()[it->second];
+  if (x.parts() != e.parts() || x.part() >= e.parts()) return {Reject::PartNumbering, x.slice()};
+  const bool cells = x.encoding() == wire::SliceEncoding::OCCUPANCY;
+  if ((cells && !x.features().empty()) || (!cells && !x.occupancy().empty())) return {Reject::MixedEncoding, x.slice()};
+  for (const auto& f : x.features())
+    if (f.u() >= announcement_.width() || f.v() >= announcement_.height()) return {Reject::KeypointOutside, x.slice()};
+  if (done_.count(x.slice())) return {};  // a duplicate of a verified slice
+
+  Partial& p = partial_[x.slice()];
+  p.parts.resize(e.parts());
+  auto& slot = p.parts[x.part()];
+  if (slot) return {};  // duplicate part
+  const size_t bytes = payloadBytes(x);
+  size_t held = 0;
+  for (const auto& q : p.parts)
+    if (q) held += payloadBytes(*q);
+  if (held + bytes > e.bytes()) {
+    partial_.erase(x.slice());
+    return {Reject::LargerThanAnnounced, x.slice()};
+  }
+  slot = x;
+  ++p.received;
+  bytes_received_ += bytes;
+  if (p.received < e.parts()) return {};
+
+  std::vector<wire::SliceFeatures> parts;
+  for (auto& q : p.parts) parts.push_back(std::move(*q));
+  partial_.erase(x.slice());
+  const auto canonical = canonicalBytes(parts);
+  if (canonical.size() != e.bytes() || crcOf(canonical) != e.crc32()) return {Reject::ChecksumMismatch, x.slice()};
+  if (parts.front().encoding() == wire::SliceEncoding::OCCUPANCY) {
+    auto decoded = inflateCells(canonical, announcement_.width(), announcement_.height());
+    if (!decoded) return {Reject::NotInflating, x.slice()};
+    cells_[x.slice()] = std::move(*decoded);
+  }
+  done_[x.slice()] = std::move(parts);
+  return {};
+}
+
+std::vector<int32_t> Reassembler::missing() const {
+  std::vector<int32_t> out;
+  for (const auto& e : announcement_.slices())
+    if (!done_.count(e.slice())) out.push_back(e.slice());
+  return out;
+}
+
+size_t Reassembler::adopt(const Reassembler& earlier) {
+  const auto& a = announcement_;
+  const auto& b = earlier.announcement_;
+  const bool same_raster = a.agent() == b.agent() && a.grid() == b.grid() && a.x_min() == b.x_min() &&
+                           a.y_min() == b.y_min() && a.z_min() == b.z_min() && a.width() == b.width() &&
+                           a.height() == b.height() && a.features() == b.features();
+  if (!same_raster) return 0;  // every cell index (or feature) means something else now
+  size_t taken = 0;
+  for (const auto& [index, position] : entries_) {
+    const auto old = earlier.entries_.find(index);
+    const auto parts = earlier.done_.find(index);
+    if (done_.count(index) || old == earlier.entries_.end() || parts == earlier.done_.end()) continue;
+    const wire::SliceEntry& now = a.slices()[position];
+    const wire::SliceEntry& then = b.slices()[old->second];
+    if (now.crc32() != then.crc32() || now.bytes() != then.bytes() || now.parts() != then.parts()) continue;
+    done_[index] = parts->second;
+    if (const auto cells = earlier.cells_.find(index); cells != earlier.cells_.end()) cells_[index] = cells->second;
+    partial_.erase(index);
+    ++taken;
+  }
+  return taken;
+}
+
+MapFeatures Reassembler::build() const {
+  const auto& a = announcement_;
+  SliceStack stack;
+  stack.grid = {a.grid(), a.x_min(), a.y_min(), a.z_min(), a.width(), a.height()};
+  stack.cells.resize(static_cast<size_t>(a.slice_count()));
+  std::vector<SliceFeatures> sent_as_features;
+  for (const auto& [index, parts] : done_) {
+    if (parts.front().encoding() == wire::SliceEncoding::OCCUPANCY)
+      stack.cells[static_cast<size_t>(index)] = cells_.at(index);
+    else
+      sent_as_features.push_back(featuresFromWire(index, parts, stack.grid));
+  }
+  MapFeatures out = extractFeatures(std::move(stack), featureParamsOf(a));
+  for (auto& s : sent_as_features) out.slices.push_back(std::move(s));
+  std::sort(out.slices.begin(), out.slices.end(),
+            [](const SliceFeatures& x, const SliceFeatures& y) { return x.index < y.index; });
+  return out;
+}
+
+}  // namespace tomomap::transport

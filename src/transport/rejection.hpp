@@ -1,0 +1,39 @@
+#pragma once
+// Why a received announcement, sample or estimate was refused: a code the
+// daemon counts and a text it logs.
+#include <cstdint>
+#include <string>
+
+namespace tomomap::transport {
+
+enum class Reject {
+  None,
+  BadGridOrOrigin,     ///< announcement: grid not positive or origin not finite
+  BadRaster,           ///< announcement: width or height 0 or above the image cap
+  BadSliceCount,
+  SliceOutOfRange,     ///< announcement lists a slice out of range or twice
+  BadPartCount,
+  OversizedSlice,      ///< announcement: a slice larger than any real slice can be
+  BadFeatureSettings,
+  VersionMismatch,     ///< announcement whose version is not the hash of its content
+  NotAnnounced,        ///< sample of a slice the announcement does not list
+  PartNumbering,
+  MixedEncoding,
+  KeypointOutside,
+  LargerThanAnnounced,
+  ChecksumMismatch,
+  NotInflating,        ///< occupancy that does not inflate to the announced raster
+  UnorderedPair,       ///< estimate whose target id is not below its source id
+  NonFiniteTransform,
+};
+
+struct Rejection {
+  Reject why = Reject::None;
+  int32_t slice = -1;  ///< the slice concerned, where there is one
+
+  explicit operator bool() const { return why != Reject::None; }
+  bool operator==(Reject r) const { return why == r; }
+  std::string text() const;
+};
+
+}  // namespace tomomap::transport

@@ -1,0 +1,96 @@
+#include "slice_encoding.hpp"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace tomomap::transport {
+namespace {
+
+void put16(std::vector<uint8_t>& b, uint16_t v) {
+  b.push_back(static_cast<uint8_t>(v & 0xff));
+  b.push_back(static_cast<uint8_t>(v >> 8));
+}
+
+}  // namespace
+
+size_t rasterBytes(size_t width, size_t height) { return (width * height + 7) / 8; }
+
+std::vector<uint8_t> deflateCells(const std::vector<uint32_t>& cells, int width, int height) {
+  std::vector<uint8_t> raster(rasterBytes(static_cast<size_t>(width), static_cast<size_t>(height)), 0);
+  for (uint32_t c : cells) raster[c / 8] = static_cast<uint8_t>(raster[c / 8] | (1u << (c % 8)));
+  uLongf size = compressBound(static_cast<uLong>(raster.size()));
+  std::vector<uint8_t> out(size);
+  if (compress2(out.data(), &size, raster.data(), static_cast<uLong>(raster.size()), Z_BEST_COMPRESSION) != Z_OK)
+    return {};
+  out.resize(size);
+  return out;
+}
+
+std::optional<std::vector<uint32_t>> inflateCells(const std::vector<uint8_t>& bytes, int width, int height) {
+  std::vector<uint8_t> raster(rasterBytes(static_cast<size_t>(width), static_cast<size_t>(height)));
+  uLongf size = static_cast<uLongf>(raster.size());
+  if (uncompress(raster.data(), &size, bytes.data(), static_cast<uLong>(bytes.size())) != Z_OK ||
+      size != raster.size())
+    return std::nullopt;
+  std::vector<uint32_t> cells;
+  const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
+  for (size_t i = 0; i < raster.size(); ++i)
+    for (uint32_t bit = 0; raster[i] >> bit; ++bit)
+      if ((raster[i] >> bit) & 1u) {
+        if (8 * i + bit >= n) return std::nullopt;  // bits past the raster's end
+        cells.push_back(static_cast<uint32_t>(8 * i + bit));
+      }
+  return cells;
+}
+
+std::vector<wire::Feature> featuresToWire(const SliceFeatures& s, const SliceGrid& g) {
+  std::vector<wire::Feature> out;
+  out.reserve(s.keypoints.size());
+  for (size_t i = 0; i < s.keypoints.size(); ++i) {
+    wire::Feature w;
+    w.u(static_cast<uint16_t>(std::lround((s.keypoints[i].x() - g.x_min) / g.cell - 0.5)));
+    w.v(static_cast<uint16_t>(std::lround((s.keypoints[i].y() - g.y_min) / g.cell - 0.5)));
+    std::copy_n(s.descriptors.ptr<uint8_t>(static_cast<int>(i)), 32, w.descriptor().begin());
+    out.push_back(w);
+  }
+  return out;
+}
+
+SliceFeatures featuresFromWire(int index, const std::vector<wire::SliceFeatures>& parts, const SliceGrid& grid) {
+  SliceFeatures s;
+  s.index = index;
+  size_t n = 0;
+  for (const auto& p : parts) n += p.features().size();
+  s.descriptors = cv::Mat(static_cast<int>(n), 32, CV_8U);
+  s.keypoints.reserve(n);
+  int row = 0;
+  for (const auto& p : parts)
+    for (const auto& f : p.features()) {
+      s.keypoints.push_back(grid.toMetres(f.u(), f.v()));
+      std::copy(f.descriptor().begin(), f.descriptor().end(), s.descriptors.ptr<uint8_t>(row++));
+    }
+  return s;
+}
+
+size_t payloadBytes(const wire::SliceFeatures& x) { return x.features().size() * kFeatureBytes + x.occupancy().size(); }
+
+std::vector<uint8_t> canonicalBytes(const std::vector<wire::SliceFeatures>& parts) {
+  std::vector<uint8_t> b;
+  for (const auto& p : parts) {
+    for (const auto& f : p.features()) {
+      put16(b, f.u());
+      put16(b, f.v());
+      b.insert(b.end(), f.descriptor().begin(), f.descriptor().end());
+    }
+    b.insert(b.end(), p.occupancy().begin(), p.occupancy().end());
+  }
+  return b;
+}
+
+uint32_t crcOf(const std::vector<uint8_t>& bytes) {
+  return static_cast<uint32_t>(crc32(crc32(0L, Z_NULL, 0), bytes.data(), static_cast<uInt>(bytes.size())));
+}
+
+}  // namespace tomomap::transport

@@ -1,0 +1,106 @@
+// Sending one's own map without a network: requests queue slices once, a
+// slice still leaving the flow controller is not queued again, a full writer
+// holds the rest for later, and a new map version drops the old queue.
+#include <gtest/gtest.h>
+
+#include "map_sender.hpp"
+
+using namespace tomomap;
+using namespace tomomap::daemon;
+using namespace std::chrono_literals;
+
+namespace {
+
+/// An offer of `slices` slices of `parts` samples each, without a real map.
+transport::MapOffer fakeOffer(int slices, int parts, uint64_t version) {
+  transport::MapOffer o;
+  o.announcement.version(version);
+  for (int k = 0; k < slices; ++k) {
+    wire::SliceEntry e;
+    e.slice(k);
+    e.parts(static_cast<uint16_t>(parts));
+    o.announcement.slices().push_back(e);
+    for (int p = 0; p < parts; ++p) {
+      wire::SliceFeatures s;
+      s.slice(k);
+      s.part(static_cast<uint16_t>(p));
+      s.parts(static_cast<uint16_t>(parts));
+      s.version(version);
+      o.samples[k].push_back(s);
+    }
+  }
+  return o;
+}
+
+/// 1000 bytes a sample at 80 kbit/s: each sample takes 0.1 s to leave.
+size_t thousand(const wire::SliceFeatures&) { return 1000; }
+
+struct Wire {
+  std::vector<std::pair<int, int>> sent;  ///< (slice, part)
+  size_t room = 1000;                     ///< samples the writer takes before it is full
+  bool publish(const wire::SliceFeatures& s) {
+    if (room == 0) return false;
+    --room;
+    sent.emplace_back(s.slice(), s.part());
+    return true;
+  }
+};
+
+const Clock::time_point t0{};
+
+}  // namespace
+
+TEST(MapSender, SendsWhatWasAskedForOnceInOrder) {
+  MapSender m(80, 1s);
+  m.setOffer(fakeOffer(3, 2, 9));
+  EXPECT_EQ(m.request(9, {2, 0}, t0), 2u);
+  EXPECT_EQ(m.request(9, {0}, t0), 1u) << "asked twice before it left: queued once";
+  EXPECT_EQ(m.queued(), 2u);
+  Wire w;
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  EXPECT_EQ(w.sent, (std::vector<std::pair<int, int>>{{2, 0}, {2, 1}, {0, 0}, {0, 1}}));
+  EXPECT_EQ(m.bytesSent(), 4000u);
+  EXPECT_EQ(m.samplesSent(), 4u);
+  EXPECT_EQ(m.queued(), 0u);
+}
+
+TEST(MapSender, ASliceStillOnItsWayIsNotSentAgain) {
+  MapSender m(80, 1s);
+  m.setOffer(fakeOffer(2, 1, 9));
+  m.request(9, {}, t0);  // everything
+  Wire w;
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  ASSERT_EQ(w.sent.size(), 2u);
+  // Slice 1 leaves the controller at 0.2 s; with 1 s of grace a request before
+  // 1.2 s crossed it, a later one means it was lost.
+  m.request(9, {1}, t0 + 1100ms);
+  EXPECT_EQ(m.queued(), 0u);
+  m.request(9, {1}, t0 + 1300ms);
+  EXPECT_EQ(m.queued(), 1u);
+}
+
+TEST(MapSender, AFullWriterHoldsTheRestForTheNextCall) {
+  MapSender m(80, 1s);
+  m.setOffer(fakeOffer(2, 2, 9));
+  m.request(9, {}, t0);
+  Wire w;
+  w.room = 3;
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  EXPECT_EQ(w.sent.size(), 3u);
+  EXPECT_EQ(m.queued(), 1u);
+  w.room = 10;
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 50ms);
+  EXPECT_EQ(w.sent.back(), std::make_pair(1, 1)) << "the slice's last part follows on";
+  EXPECT_EQ(m.queued(), 0u);
+}
+
+TEST(MapSender, ANewVersionDropsTheOldQueueAndOldRequests) {
+  MapSender m(80, 1s);
+  m.setOffer(fakeOffer(3, 1, 9));
+  m.request(9, {}, t0);
+  m.setOffer(fakeOffer(3, 1, 10));
+  EXPECT_EQ(m.queued(), 0u);
+  EXPECT_EQ(m.request(9, {0, 1}, t0), 0u) << "a request for the old version";
+  EXPECT_EQ(m.request(10, {0, 7}, t0), 1u) << "slice 7 does not exist";
+  EXPECT_EQ(m.queued(), 1u);
+}
