@@ -2,12 +2,13 @@
 // The paper's comparison method: FPFH descriptors on keypoints + RANSAC
 // (PCL's SampleConsensusPrerejective), as map-merging tools commonly use it.
 // Radii scale with the grid size so that it runs on the same pairs as tomomap.
+#include "core/matcher.hpp"
 #include "core/types.hpp"
 
 namespace tomomap::baseline {
 
 struct FpfhParams {
-  double grid = 0.05;                ///< the pair's grid size g [m]; everything below scales with it
+  double grid = MatchParams{}.grid;  ///< the pair's grid size g [m]; everything below scales with it
   double keypoint_cells = 2.0;       ///< keypoints and descriptor surface: voxel centroids at this many g
   double normal_radius_cells = 4.0;  ///< normal estimation radius [g]
   double feature_radius_cells = 10.0;  ///< FPFH radius [g]

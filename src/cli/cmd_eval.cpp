@@ -11,10 +11,13 @@
 #include <sstream>
 
 #include "child_process.hpp"
+#include "core/stats.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "io/map_io.hpp"
 #include "suite.hpp"
 #include "synth_files.hpp"
+#include "transport/wire_sizes.hpp"
 #include "viz/box_plot.hpp"
 
 namespace tomomap::cli {
@@ -22,9 +25,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Bytes one feature costs on the wire: a 32-byte ORB descriptor and x, y
-/// quantised to the grid as two 16-bit integers. Plus 8 bytes per slice header.
-constexpr double kBytesPerFeature = 36, kBytesPerSlice = 8, kBytesPerRawPoint = 12;
+/// Bytes a slice's header adds to its features (transport::kFeatureBytes each)
+/// in the payload estimate.
+constexpr double kBytesPerSlice = 8;
 
 struct Row {
   std::string pair, noise, method;
@@ -84,8 +87,8 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   const auto& s = j["slices"];
   row.features = s.value("target_features", 0.0) + s.value("source_features", 0.0);
   row.slices = s.value("target", 0.0) + s.value("source", 0.0);
-  row.raw_bytes = kBytesPerRawPoint * (j.value("target_points", 0.0) + j.value("source_points", 0.0));
-  if (method == "tomomap") row.payload_bytes = kBytesPerFeature * row.features + kBytesPerSlice * row.slices;
+  row.raw_bytes = static_cast<double>(kPcdBytesPerPoint) * (j.value("target_points", 0.0) + j.value("source_points", 0.0));
+  if (method == "tomomap") row.payload_bytes = static_cast<double>(transport::kFeatureBytes) * row.features + kBytesPerSlice * row.slices;
   return row;
 }
 
@@ -94,13 +97,6 @@ std::string shortNumber(double v) {
   std::ostringstream o;
   o << v;
   return o.str();
-}
-
-double percentile(std::vector<double> v, double q) {
-  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  return v[static_cast<size_t>(std::lround(q * static_cast<double>(v.size() - 1)))];
 }
 
 std::string summary(const std::string& suite, const std::vector<Row>& rows) {
@@ -129,9 +125,9 @@ std::string summary(const std::string& suite, const std::vector<Row>& rows) {
       rss[key.first].push_back(r->peak_rss_mb);
     }
     o << "| " << key.first << " | " << key.second << " | " << g.size() << " | " << ok << "/" << g.size() << " | "
-      << std::setprecision(3) << percentile(te, 0.5) << " | " << percentile(te, 0.9) << " | " << std::setprecision(4)
-      << percentile(ye, 0.5) << " | " << percentile(ye, 0.9) << " | " << std::setprecision(2) << percentile(t, 0.5)
-      << " | " << std::setprecision(0) << percentile(m, 1.0) << " | ";
+      << std::setprecision(3) << quantile(te, 0.5) << " | " << quantile(te, 0.9) << " | " << std::setprecision(4)
+      << quantile(ye, 0.5) << " | " << quantile(ye, 0.9) << " | " << std::setprecision(2) << quantile(t, 0.5)
+      << " | " << std::setprecision(0) << quantile(m, 1.0) << " | ";
     if (payload > 0 && raw > 0)
       o << std::setprecision(1) << 100.0 * payload / raw << " %";
     else
@@ -140,8 +136,8 @@ std::string summary(const std::string& suite, const std::vector<Row>& rows) {
   }
   if (times.count("tomomap") && times.count("fpfh-ransac")) {
     o << std::setprecision(1) << "\nfpfh-ransac / tomomap: median time "
-      << percentile(times["fpfh-ransac"], 0.5) / percentile(times["tomomap"], 0.5) << "x, peak memory "
-      << percentile(rss["fpfh-ransac"], 1.0) / percentile(rss["tomomap"], 1.0) << "x\n";
+      << quantile(times["fpfh-ransac"], 0.5) / quantile(times["tomomap"], 0.5) << "x, peak memory "
+      << quantile(rss["fpfh-ransac"], 1.0) / quantile(rss["tomomap"], 1.0) << "x\n";
   }
   return o.str();
 }

@@ -18,6 +18,7 @@
 #include "core/text.hpp"
 #include "core/types.hpp"
 #include "exit_codes.hpp"
+#include "results/agreed_transform.hpp"
 
 namespace tomomap::cli {
 namespace {
@@ -60,10 +61,10 @@ std::string kB(double bytes) { return fixed(bytes / 1000, 1) + " kB"; }
 bool processAlive(int pid) { return pid > 0 && (::kill(pid, 0) == 0 || errno == EPERM); }
 
 /// The version each agent's map has now, as far as this daemon knows.
-std::map<std::string, std::string> currentVersions(const json& status) {
-  std::map<std::string, std::string> v{{status.value("agent", ""), status["map"].value("version", "")}};
+std::map<std::string, uint64_t> currentVersions(const json& status) {
+  std::map<std::string, uint64_t> v{{status.value("agent", ""), parseVersion(status["map"].value("version", ""))}};
   for (const auto& [id, p] : status["peers"].items())
-    if (p.contains("version")) v[id] = p["version"];
+    if (p.contains("version")) v[id] = parseVersion(p["version"].get<std::string>());
   return v;
 }
 
@@ -98,23 +99,21 @@ void printHuman(const json& status, const json& transforms, bool running) {
   const auto versions = currentVersions(status);
   const json& list = transforms["transforms"];
   std::cout << "  transforms (" << list.size() << ")\n";
-  for (const auto& t : list) {
-    const std::string target = t.value("target", "?"), source = t.value("source", "?");
-    std::cout << "    " << target << " <- " << source << "  ";
-    if (t.value("reliable", false)) {
-      const json& T = t["T_target_source"];
-      std::cout << "x " << fixed(T["x"], 3) << "  y " << fixed(T["y"], 3) << "  z " << fixed(T["z"], 3) << "  yaw "
-                << fixed(degrees(T["yaw"].get<double>()), 2) << " deg";
+  for (const auto& entry : list) {
+    const AgreedTransform t = agreedFromJson(entry);
+    std::cout << "    " << t.target << " <- " << t.source << "  ";
+    if (t.reliable) {
+      const Pose4& T = t.T_target_source;
+      std::cout << "x " << fixed(T.x, 3) << "  y " << fixed(T.y, 3) << "  z " << fixed(T.z, 3) << "  yaw "
+                << fixed(degrees(T.yaw), 2) << " deg";
     } else {
-      std::cout << "no reliable match: " << t.value("reason", "");
+      std::cout << "no reliable match: " << t.reason;
     }
-    const json& q = t["quality"];
-    std::cout << "\n        support " << q.value("support", 0) << " slice pairs (runner-up " << q.value("runner_up_support", 0)
-              << "), " << q.value("inliers", 0) << " inliers; computed by " << t.value("computed_by", "?") << " in "
-              << fixed(t.value("matching_seconds", 0.0), 2) << " s, " << ago(t.value("computed_at_ms", 0.0));
-    const bool current = versions.count(target) && versions.count(source) &&
-                         versions.at(target) == t.value("target_version", "") &&
-                         versions.at(source) == t.value("source_version", "");
+    std::cout << "\n        support " << t.support << " slice pairs (runner-up " << t.runner_up_support << "), "
+              << t.inliers << " inliers; computed by " << t.computed_by << " in " << fixed(t.seconds, 2) << " s, "
+              << ago(static_cast<double>(t.computed_at_ms));
+    const bool current = versions.count(t.target) && versions.count(t.source) &&
+                         t.isFor(versions.at(t.target), versions.at(t.source));
     std::cout << (current ? "" : "; STALE: a map changed since, recomputing") << "\n";
   }
 }

@@ -94,7 +94,7 @@ Suite loadSuite(const std::string& path) {
       p.gt_source = resolve(text(path, *t, "gt_source", "[[pair]]"));
       p.name = text(path, *t, "name", "[[pair]]",
                     fs::path(p.source).stem().string() + " -> " + fs::path(p.target).stem().string());
-      p.grid = number(path, *t, "grid", 0.05);
+      p.grid = number(path, *t, "grid", p.grid);
       std::string missing;
       for (const auto* f : {&p.target, &p.source, &p.gt_target, &p.gt_source})
         if (!fs::exists(*f)) missing = *f;

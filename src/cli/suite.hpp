@@ -4,12 +4,14 @@
 #include <string>
 #include <vector>
 
+#include "core/matcher.hpp"
+
 namespace tomomap::cli {
 
 struct SuitePair {
   std::string name;
   std::string target, source, gt_target, gt_source;  ///< paths (resolved against the suite's folder)
-  double grid = 0.05;
+  double grid = MatchParams{}.grid;  ///< [m]
   std::string noise = "real";  ///< noise label for grouping: real data, or the synth level
 };
 

@@ -60,7 +60,8 @@ DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& 
         for (const auto& s : p.source) {
           const Eigen::Vector2d q = T.apply(s);
           // Target pixel coordinates (centres are integers).
-          const double fu = (q.x() - tg.x_min) / cell - 0.5, fv = (q.y() - tg.y_min) / cell - 0.5;
+          const Eigen::Vector2d f = tg.toPixel(q.x(), q.y());
+          const double fu = f.x(), fv = f.y();
           const int u0 = static_cast<int>(std::lround(fu)), v0 = static_cast<int>(std::lround(fv));
           double best = max_d2;
           int bu = -1, bv = -1;

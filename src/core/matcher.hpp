@@ -1,27 +1,12 @@
 #pragma once
 // Height cross-correlation of two tomographic feature stacks (ALGORITHM.md sections 4-7).
-#include <functional>
 #include <string>
 
-#include "consensus.hpp"
-#include "features.hpp"
+#include "match_params.hpp"
 #include "rigid2d.hpp"
+#include "slice_pairs.hpp"
 
 namespace tomomap {
-
-struct MatchParams {
-  double grid = 0.05;                  ///< voxel, pixel and slice size g [m]
-  FeatureParams features;
-  double ransac_threshold_cells = 3.0; ///< RANSAC inlier distance [grid cells]
-  int ransac_iterations = 2000;        ///< upper bound per slice pair
-  double ransac_confidence = 0.999;
-  int min_matches = 5;                 ///< fewer mutual matches: the slice pair gives no estimate
-  double consensus_translation_cells = 5.0;      ///< [grid cells]
-  double consensus_yaw = radians(10.0); ///< [rad]
-  int min_support = 3;                 ///< agreeing slice pairs needed for a reliable match
-  int min_inliers = 20;                ///< inlier correspondences needed for a reliable match
-  int threads = 0;                     ///< 0 = all cores
-};
 
 /// Wall-clock seconds per stage.
 struct StageTimings {
@@ -61,14 +46,9 @@ struct MatchResult {
   StageTimings timings;
 };
 
-/// Called with (stage name, done, total) as work advances; may be empty.
-using Progress = std::function<void(const char*, size_t, size_t)>;
-
-/// Mutual nearest neighbours in Hamming distance between two slices' descriptors,
-/// as matched map-frame positions (source -> target).
-Correspondences matchSlices(const SliceFeatures& target, const SliceFeatures& source);
-
-/// Finds T_target_source from two feature stacks of the same grid size.
+/// Finds T_target_source from two feature stacks of the same grid size: slice
+/// pairs estimated (slice_pairs.hpp), height offsets scored and the best picked
+/// (height_offsets.hpp), the winner refined (refine.hpp), the answer judged.
 MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source,
                           const MatchParams& params, const Progress& progress = {});
 

@@ -1,6 +1,5 @@
 #include "rigid2d.hpp"
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <random>
 
@@ -8,17 +7,36 @@ namespace tomomap {
 
 Rigid2D fitRigid2D(const Correspondences& c, const std::vector<uint32_t>* subset) {
   const size_t n = subset ? subset->size() : c.size();
-  Eigen::Matrix2Xd src(2, n), dst(2, n);
+  auto at = [&](size_t k) { return subset ? (*subset)[k] : k; };
+  Eigen::Vector2d ms = Eigen::Vector2d::Zero(), mt = Eigen::Vector2d::Zero();
   for (size_t k = 0; k < n; ++k) {
-    const size_t i = subset ? (*subset)[k] : k;
-    src.col(static_cast<Eigen::Index>(k)) = c.source[i];
-    dst.col(static_cast<Eigen::Index>(k)) = c.target[i];
+    ms += c.source[at(k)];
+    mt += c.target[at(k)];
   }
-  const Eigen::Matrix3d m = Eigen::umeyama(src, dst, false);
+  ms /= static_cast<double>(n);
+  mt /= static_cast<double>(n);
+  double cross = 0, dot = 0;
+  for (size_t k = 0; k < n; ++k) {
+    const Eigen::Vector2d s = c.source[at(k)] - ms, t = c.target[at(k)] - mt;
+    cross += s.x() * t.y() - s.y() * t.x();
+    dot += s.dot(t);
+  }
   Rigid2D T;
-  T.yaw = std::atan2(m(1, 0), m(0, 0));
-  T.t = m.block<2, 1>(0, 2);
+  T.yaw = std::atan2(cross, dot);
+  T.t = mt - Rigid2D{T.yaw, Eigen::Vector2d::Zero()}.apply(ms);
   return T;
+}
+
+RigidEstimate refineLeastSquares(const Correspondences& c, RigidEstimate est, double threshold, RefineRule rule) {
+  for (int round = 0; round < rule.max_rounds && est.inliers.size() >= 2; ++round) {
+    const Rigid2D refined = fitRigid2D(c, &est.inliers);
+    auto next = collectInliers(c, refined, threshold);
+    if (next.size() < (rule.allow_shrinking ? size_t{2} : est.inliers.size())) break;  // drifted: keep the last
+    const bool same = next == est.inliers;
+    est = {refined, std::move(next)};
+    if (same) break;
+  }
+  return est;
 }
 
 std::vector<uint32_t> collectInliers(const Correspondences& c, const Rigid2D& T, double threshold) {
@@ -72,15 +90,8 @@ std::optional<RigidEstimate> ransacRigid2D(const Correspondences& c, const Ransa
   }
   if (best_count < static_cast<size_t>(std::max(params.min_inliers, 2))) return std::nullopt;
 
-  RigidEstimate est{best, collectInliers(c, best, params.inlier_threshold)};
-  for (int round = 0; round < 5; ++round) {
-    const Rigid2D refined = fitRigid2D(c, &est.inliers);
-    auto inliers = collectInliers(c, refined, params.inlier_threshold);
-    if (inliers.size() < est.inliers.size()) break;  // refinement drifted: keep the last good one
-    const bool same = inliers == est.inliers;
-    est = {refined, std::move(inliers)};
-    if (same) break;
-  }
+  const RigidEstimate est = refineLeastSquares(c, {best, collectInliers(c, best, params.inlier_threshold)},
+                                               params.inlier_threshold, {5, /*allow_shrinking=*/false});
   if (est.inliers.size() < static_cast<size_t>(params.min_inliers)) return std::nullopt;
   return est;
 }

@@ -34,9 +34,25 @@ struct RigidEstimate {
   std::vector<uint32_t> inliers; ///< indices into the correspondences
 };
 
-/// Least-squares rigid fit (closed form, Umeyama without scale) of the selected
-/// correspondences; all of them when `subset` is null. Needs two or more.
+/// Least-squares rigid fit of the selected correspondences (all of them when
+/// `subset` is null); needs two or more. Closed form: with the pairs centred,
+/// yaw = atan2(sum of cross products, sum of dot products), and the
+/// translation takes the source centroid onto the target's.
 Rigid2D fitRigid2D(const Correspondences& c, const std::vector<uint32_t>* subset = nullptr);
+
+/// How refineLeastSquares stops.
+struct RefineRule {
+  int max_rounds = 5;
+  /// Whether a round may keep fewer inliers than the last (down to two).
+  /// RANSAC's own refinement does not: fewer means it drifted from a good
+  /// sample. Starting from a consensus mean, the set may rightly shrink.
+  bool allow_shrinking = false;
+};
+
+/// Alternates a least-squares fit on the inliers with re-collecting the
+/// inliers within `threshold` [m], until they stop changing, `rule` stops it,
+/// or fewer than two remain. The result's inliers are those of its transform.
+RigidEstimate refineLeastSquares(const Correspondences& c, RigidEstimate start, double threshold, RefineRule rule);
 
 /// RANSAC on two-point samples, then least-squares refinement on the inliers
 /// (re-collecting inliers until they stop changing). `seed` makes it repeatable.

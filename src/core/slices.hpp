@@ -21,6 +21,8 @@ struct SliceGrid {
   Eigen::Vector2f toMetres(float u, float v) const {
     return {static_cast<float>(x_min + (u + 0.5) * cell), static_cast<float>(y_min + (v + 0.5) * cell)};
   }
+  /// The inverse: (sub)pixel position of map-frame x, y [m]; centres are integers.
+  Eigen::Vector2d toPixel(double x, double y) const { return {(x - x_min) / cell - 0.5, (y - y_min) / cell - 0.5}; }
 };
 
 /// Occupied cells per slice, stored sparsely (pixel index v * width + u, sorted,

@@ -2,6 +2,8 @@
 
 #include <random>
 
+#include "core/matcher.hpp"
+
 namespace tomomap::synth {
 namespace {
 
@@ -77,7 +79,7 @@ void furnish(World& w, Rng& rng, const Room& r, double z0) {
 Scene indoorScene(const SceneParams& p) {
   Rng rng(p.seed * 7919 + 17);
   Scene s;
-  s.grid = 0.05;
+  s.grid = MatchParams{}.grid;  // the matcher's default is the indoor grid
   s.map_resolution = 0.03;
   s.sensor = {24, -0.75, 0.75, 240, 9.0};
   const double W = 24.0 * p.scale, D = 14.0, yc0 = D / 2 - 1.0, yc1 = D / 2 + 1.0;

@@ -50,8 +50,9 @@ std::vector<wire::Feature> featuresToWire(const SliceFeatures& s, const SliceGri
   out.reserve(s.keypoints.size());
   for (size_t i = 0; i < s.keypoints.size(); ++i) {
     wire::Feature w;
-    w.u(static_cast<uint16_t>(std::lround((s.keypoints[i].x() - g.x_min) / g.cell - 0.5)));
-    w.v(static_cast<uint16_t>(std::lround((s.keypoints[i].y() - g.y_min) / g.cell - 0.5)));
+    const Eigen::Vector2d px = g.toPixel(s.keypoints[i].x(), s.keypoints[i].y());
+    w.u(static_cast<uint16_t>(std::lround(px.x())));
+    w.v(static_cast<uint16_t>(std::lround(px.y())));
     std::copy_n(s.descriptors.ptr<uint8_t>(static_cast<int>(i)), 32, w.descriptor().begin());
     out.push_back(w);
   }

@@ -4,17 +4,9 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "core/stats.hpp"
+
 namespace tomomap::viz {
-namespace {
-
-double quantile(const std::vector<double>& sorted, double q) {
-  const double at = q * static_cast<double>(sorted.size() - 1);
-  const size_t i = static_cast<size_t>(std::floor(at));
-  const size_t j = std::min(i + 1, sorted.size() - 1);
-  return sorted[i] + (at - static_cast<double>(i)) * (sorted[j] - sorted[i]);
-}
-
-}  // namespace
 
 cv::Mat drawBoxPanel(const BoxPanel& p, cv::Size size) {
   cv::Mat img(size, CV_8UC3, colour::kWhite);

@@ -1,5 +1,7 @@
 #include "match_pictures.hpp"
 
+#include "core/rigid2d.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <opencv2/features2d.hpp>
@@ -48,8 +50,8 @@ cv::Mat drawOverlay(const SliceStack& target, const SliceStack& source, const Po
                     const std::vector<std::string>& caption) {
   std::vector<Eigen::Vector2d> t_xy = verticalStructure(target);
   std::vector<Eigen::Vector2d> s_xy = verticalStructure(source);
-  const double c = std::cos(T.yaw), s = std::sin(T.yaw);
-  for (auto& p : s_xy) p = Eigen::Vector2d(c * p.x() - s * p.y() + T.x, s * p.x() + c * p.y() + T.y);
+  const Rigid2D planar{T.yaw, {T.x, T.y}};
+  for (auto& p : s_xy) p = planar.apply(p);
 
   Eigen::Vector2d lo(INFINITY, INFINITY), hi(-INFINITY, -INFINITY);
   for (const auto* set : {&t_xy, &s_xy})
@@ -143,8 +145,8 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
     cv::resize(left, left, {}, f, f, f >= 1 ? cv::INTER_NEAREST : cv::INTER_AREA);
     cv::resize(right, right, {}, f, f, f >= 1 ? cv::INTER_NEAREST : cv::INTER_AREA);
     auto toPixel = [&](const SliceGrid& g, const Eigen::Vector2d& p) {
-      return cv::Point2f(static_cast<float>(((p.x() - g.x_min) / g.cell - 0.5 + pad + 0.5) * f),
-                         static_cast<float>(((p.y() - g.y_min) / g.cell - 0.5 + pad + 0.5) * f));
+      const Eigen::Vector2d px = g.toPixel(p.x(), p.y());  // scaled about pixel corners: + 0.5
+      return cv::Point2f(static_cast<float>((px.x() + pad + 0.5) * f), static_cast<float>((px.y() + pad + 0.5) * f));
     };
     std::vector<cv::KeyPoint> kt, ks;
     std::vector<cv::DMatch> matches;

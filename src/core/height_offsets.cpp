@@ -1,0 +1,49 @@
+#include "height_offsets.hpp"
+
+#include <algorithm>
+#include <map>
+
+namespace tomomap {
+
+std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeatures& target,
+                                      const MapFeatures& source, const MatchParams& params) {
+  // Each (target, source) slice pair belongs to exactly one height offset.
+  std::map<int, std::vector<size_t>> by_offset;
+  for (size_t k = 0; k < table.estimates.size(); ++k)
+    if (table.estimates[k].ok)
+      by_offset[target.slices[k / table.ns].index - source.slices[k % table.ns].index].push_back(k);
+  ConsensusParams cp;
+  cp.translation_tolerance = params.consensus_translation_cells * params.grid;
+  cp.yaw_tolerance = params.consensus_yaw;
+  std::vector<OffsetScore> scores;
+  for (const auto& [offset, members] : by_offset) {
+    std::vector<Rigid2D> estimates;
+    std::vector<double> weights;
+    for (size_t k : members) {
+      estimates.push_back(table.estimates[k].T);
+      weights.push_back(table.estimates[k].inliers);
+    }
+    OffsetScore s{offset, findConsensus(estimates, cp, weights), 0};
+    for (size_t& i : s.consensus.supporters) {
+      i = members[i];  // from index into `estimates` to index into the table
+      s.inlier_sum += table.estimates[i].inliers;
+    }
+    scores.push_back(std::move(s));
+  }
+  return scores;
+}
+
+OffsetChoice pickOffset(const std::vector<OffsetScore>& scores) {
+  OffsetChoice c;
+  if (scores.empty()) return c;
+  c.best = &*std::max_element(scores.begin(), scores.end(), [](const OffsetScore& x, const OffsetScore& y) {
+    if (x.consensus.support() != y.consensus.support()) return x.consensus.support() < y.consensus.support();
+    return x.inlier_sum < y.inlier_sum;
+  });
+  for (const auto& s : scores)
+    if (std::abs(s.offset - c.best->offset) > 1)
+      c.runner_up_support = std::max(c.runner_up_support, static_cast<int>(s.consensus.support()));
+  return c;
+}
+
+}  // namespace tomomap

@@ -1,0 +1,81 @@
+#include "slice_pairs.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+
+#include "hamming.hpp"
+
+namespace tomomap {
+namespace {
+
+/// Source and target positions of `matches` (source index, target index).
+template <typename Matches>
+Correspondences positions(const SliceFeatures& target, const SliceFeatures& source, const Matches& matches) {
+  Correspondences c;
+  c.source.reserve(matches.size());
+  c.target.reserve(matches.size());
+  for (const auto& [s, t] : matches) {
+    c.source.push_back(source.keypoints[static_cast<size_t>(s)].cast<double>());
+    c.target.push_back(target.keypoints[static_cast<size_t>(t)].cast<double>());
+  }
+  return c;
+}
+
+}  // namespace
+
+int matchThreads(const MatchParams& params) { return params.threads > 0 ? params.threads : omp_get_max_threads(); }
+
+RansacParams ransacParams(const MatchParams& p) {
+  RansacParams r;
+  r.inlier_threshold = p.ransac_threshold_cells * p.grid;
+  r.max_iterations = p.ransac_iterations;
+  r.confidence = p.ransac_confidence;
+  r.min_inliers = std::max(3, p.min_matches / 2);
+  return r;
+}
+
+Correspondences matchSlices(const SliceFeatures& target, const SliceFeatures& source) {
+  return positions(target, source, mutualNearest(source.descriptors, target.descriptors));
+}
+
+Correspondences correspondencesOf(const SlicePairTable& table, const MapFeatures& target, const MapFeatures& source,
+                                  size_t a, size_t b) {
+  return positions(target.slices[a], source.slices[b], table.matches[table.index(a, b)]);
+}
+
+SlicePairTable estimateSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
+                                  const Progress& progress) {
+  SlicePairTable table;
+  table.nt = target.slices.size();
+  table.ns = source.slices.size();
+  const size_t n = table.nt * table.ns;
+  table.estimates.resize(n);
+  table.matches.resize(n);
+  const RansacParams ransac = ransacParams(params);
+  std::atomic<size_t> done{0};
+  const size_t report_every = std::max<size_t>(1, n / 100);
+#pragma omp parallel for schedule(dynamic, 4) num_threads(matchThreads(params))
+  for (long long k = 0; k < static_cast<long long>(n); ++k) {
+    const size_t a = static_cast<size_t>(k) / table.ns, b = static_cast<size_t>(k) % table.ns;
+    const auto matches = mutualNearest(source.slices[b].descriptors, target.slices[a].descriptors);
+    auto& kept = table.matches[static_cast<size_t>(k)];
+    kept.reserve(matches.size());
+    for (const auto& [s, t] : matches) kept.emplace_back(static_cast<uint16_t>(s), static_cast<uint16_t>(t));
+    if (matches.size() >= static_cast<size_t>(params.min_matches)) {
+      const Correspondences c = positions(target.slices[a], source.slices[b], matches);
+      // Seeded per pair so results do not depend on thread scheduling.
+      if (auto est = ransacRigid2D(c, ransac, 0x9E3779B97F4A7C15ull * (a + 1) + b))
+        table.estimates[static_cast<size_t>(k)] = {true, est->transform, static_cast<uint32_t>(est->inliers.size())};
+    }
+    const size_t finished = ++done;
+    if (progress && finished % report_every == 0) {
+#pragma omp critical(tomomap_progress)
+      progress("slice pairs", finished, n);
+    }
+  }
+  return table;
+}
+
+}  // namespace tomomap
