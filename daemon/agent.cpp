@@ -46,17 +46,18 @@ void Agent::installOwnMap(OwnMap own) {
   board_.ownMap(sender_.version());
   const auto& offer = sender_.offer();
   size_t as_cells = 0;
-  for (const auto& [k, samples] : offer.samples) as_cells += samples.front().encoding() == wire::SliceEncoding::OCCUPANCY;
+  for (const auto& [k, samples] : offer.samples)
+    as_cells += samples.front().encoding() == wire::SliceEncoding::OCCUPANCY;
   const auto& a = offer.announcement;
-  log_.info(std::string(update ? "map updated: " : "map ") + config_.map + ": " + std::to_string(own.cells) +
-            " cells at g " + fixed(config_.match.grid, 3) + " m, " + std::to_string(a.slices().size()) +
-            " descriptive slices (" + std::to_string(as_cells) + " sent as occupancy, the rest as features), " +
-            std::to_string(own_features_->featureCount()) + " features; version " + versionText(a.version()) +
-            (update ? " (was " + versionText(before) + ")" : "") + "; payload " + std::to_string(offer.payload_bytes) +
-            " bytes = " +
-            fixed(100.0 * static_cast<double>(offer.payload_bytes) / static_cast<double>(a.raw_bytes()), 1) +
-            " % of the voxel-filtered map's binary PCD (" + std::to_string(a.raw_bytes()) + " bytes); described in " +
-            fixed(own.seconds, 2) + " s");
+  log_.info(
+      std::string(update ? "map updated: " : "map ") + config_.map + ": " + std::to_string(own.cells) + " cells at g " +
+      fixed(config_.match.grid, 3) + " m, " + std::to_string(a.slices().size()) + " descriptive slices (" +
+      std::to_string(as_cells) + " sent as occupancy, the rest as features), " +
+      std::to_string(own_features_->featureCount()) + " features; version " + versionText(a.version()) +
+      (update ? " (was " + versionText(before) + ")" : "") + "; payload " + std::to_string(offer.payload_bytes) +
+      " bytes = " + fixed(100.0 * static_cast<double>(offer.payload_bytes) / static_cast<double>(a.raw_bytes()), 1) +
+      " % of the voxel-filtered map's binary PCD (" + std::to_string(a.raw_bytes()) + " bytes); described in " +
+      fixed(own.seconds, 2) + " s");
   if (bus_) {
     bus_->publish(a);
     persist(false);
@@ -194,10 +195,10 @@ void Agent::finishCompute() {
   ++counters_.matches_computed;
   const Pose4& T = t.T_target_source;
   log_.info("computed " + pairText(t.pair()) + " in " + fixed(t.seconds, 2) + " s: " +
-            (t.reliable ? "x " + fixed(T.x, 3) + " y " + fixed(T.y, 3) + " z " + fixed(T.z, 3) + " yaw " +
-                              fixed(T.yaw, 4) + ", support " + std::to_string(t.support) + ", " +
-                              std::to_string(t.inliers) + " inliers"
-                        : "no reliable match: " + t.reason));
+            (t.reliable
+                 ? "x " + fixed(T.x, 3) + " y " + fixed(T.y, 3) + " z " + fixed(T.z, 3) + " yaw " + fixed(T.yaw, 4) +
+                       ", support " + std::to_string(t.support) + ", " + std::to_string(t.inliers) + " inliers"
+                 : "no reliable match: " + t.reason));
   bus_->publish(transport::toWire(t));
   board_.computed(std::move(t));
   persist(true);

@@ -118,8 +118,7 @@ void Agent::tick(Clock::time_point& last_announce) {
   finishCompute();
   followMapFile();
   const auto now = Clock::now();
-  sender_.pump([this](const wire::SliceFeatures& x) { return bus_->publish(x); }, transport::Bus::serializedSize,
-               now);
+  sender_.pump([this](const wire::SliceFeatures& x) { return bus_->publish(x); }, transport::Bus::serializedSize, now);
   requestMissing();
   claimAndCompute();
   if (now - last_announce > kReannounce) {  // repairs a lost or missed announcement

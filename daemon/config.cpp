@@ -15,21 +15,40 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const std::vector<std::string> kKeys{
-    "agent",          "map",        "grid",           "domain",          "address",
-    "discovery_port", "data_port",  "bandwidth_kbps", "output_dir",      "log_level",
-    "claim_timeout_s", "request_interval_s", "peer.id", "peer.host",     "peer.port",
-    "match.max_features", "match.fast_threshold", "match.ransac_threshold_cells", "match.ransac_iterations",
-    "match.ransac_confidence", "match.min_matches", "match.consensus_translation_cells",
-    "match.consensus_yaw_deg", "match.min_support", "match.min_inliers", "match.threads"};
+const std::vector<std::string> kKeys{"agent",
+                                     "map",
+                                     "grid",
+                                     "domain",
+                                     "address",
+                                     "discovery_port",
+                                     "data_port",
+                                     "bandwidth_kbps",
+                                     "output_dir",
+                                     "log_level",
+                                     "claim_timeout_s",
+                                     "request_interval_s",
+                                     "peer.id",
+                                     "peer.host",
+                                     "peer.port",
+                                     "match.max_features",
+                                     "match.fast_threshold",
+                                     "match.ransac_threshold_cells",
+                                     "match.ransac_iterations",
+                                     "match.ransac_confidence",
+                                     "match.min_matches",
+                                     "match.consensus_translation_cells",
+                                     "match.consensus_yaw_deg",
+                                     "match.min_support",
+                                     "match.min_inliers",
+                                     "match.threads"};
 
 struct Reader {
   std::string file;
 
   [[noreturn]] void fail(const toml::node& n, const std::string& key, const std::string& what) const {
     const auto& b = n.source().begin;
-    throw InputError(file + ":" + std::to_string(b.line) + ":" + std::to_string(b.column) + ": key '" + key + "': " +
-                     what);
+    throw InputError(file + ":" + std::to_string(b.line) + ":" + std::to_string(b.column) + ": key '" + key +
+                     "': " + what);
   }
   /// An integer key: a number from lo to hi with no fraction.
   int integer(const toml::table& t, const std::string& key, int fallback, int lo, int hi) const {
@@ -62,8 +81,7 @@ struct Reader {
       missing(t, key);
     }
     const auto v = n->value<double>();
-    if (!v || !(*v >= lo && *v <= hi))
-      fail(*n, key, "must be a number from " + toString(lo) + " to " + toString(hi));
+    if (!v || !(*v >= lo && *v <= hi)) fail(*n, key, "must be a number from " + toString(lo) + " to " + toString(hi));
     return *v;
   }
 
@@ -98,8 +116,7 @@ void readMatch(const Reader& r, const toml::table& root, MatchParams& m) {
   m.ransac_iterations = in.integer(*t, "ransac_iterations", m.ransac_iterations, 10, 100000);
   m.ransac_confidence = in.number(*t, "ransac_confidence", m.ransac_confidence, 0.5, 0.999999);
   m.min_matches = in.integer(*t, "min_matches", m.min_matches, 2, 1000);
-  m.consensus_translation_cells =
-      in.number(*t, "consensus_translation_cells", m.consensus_translation_cells, 0.5, 100);
+  m.consensus_translation_cells = in.number(*t, "consensus_translation_cells", m.consensus_translation_cells, 0.5, 100);
   m.consensus_yaw = radians(in.number(*t, "consensus_yaw_deg", degrees(m.consensus_yaw), 0.1, 90));
   m.min_support = in.integer(*t, "min_support", m.min_support, 1, 1000);
   m.min_inliers = in.integer(*t, "min_inliers", m.min_inliers, 2, 100000);
@@ -160,11 +177,16 @@ Config loadConfig(const std::string& path) {
   const char* state_dir = std::getenv("STATE_DIRECTORY");
   c.output_dir = resolve(r.text(root, "output_dir", state_dir && *state_dir ? state_dir : "/var/lib/tomomap"));
   const std::string level = r.text(root, "log_level", "info");
-  if (level == "debug") c.log_level = LogLevel::Debug;
-  else if (level == "info") c.log_level = LogLevel::Info;
-  else if (level == "warning") c.log_level = LogLevel::Warning;
-  else if (level == "error") c.log_level = LogLevel::Error;
-  else r.fail(*root.get("log_level"), "log_level", "must be debug, info, warning or error");
+  if (level == "debug")
+    c.log_level = LogLevel::Debug;
+  else if (level == "info")
+    c.log_level = LogLevel::Info;
+  else if (level == "warning")
+    c.log_level = LogLevel::Warning;
+  else if (level == "error")
+    c.log_level = LogLevel::Error;
+  else
+    r.fail(*root.get("log_level"), "log_level", "must be debug, info, warning or error");
   c.claim_timeout_s = r.number(root, "claim_timeout_s", 30, 1, 3600);
   c.request_interval_s = r.number(root, "request_interval_s", 1, 0.1, 600);
 
@@ -204,8 +226,8 @@ std::string describe(const Config& c) {
     << "\n  request_interval_s = " << c.request_interval_s << "\n  match.max_features = " << m.features.max_features
     << "\n  match.fast_threshold = " << m.features.fast_threshold
     << "\n  match.ransac_threshold_cells = " << m.ransac_threshold_cells
-    << "\n  match.ransac_iterations = " << m.ransac_iterations << "\n  match.ransac_confidence = " << m.ransac_confidence
-    << "\n  match.min_matches = " << m.min_matches
+    << "\n  match.ransac_iterations = " << m.ransac_iterations
+    << "\n  match.ransac_confidence = " << m.ransac_confidence << "\n  match.min_matches = " << m.min_matches
     << "\n  match.consensus_translation_cells = " << m.consensus_translation_cells
     << "\n  match.consensus_yaw_deg = " << degrees(m.consensus_yaw) << "\n  match.min_support = " << m.min_support
     << "\n  match.min_inliers = " << m.min_inliers << "\n  match.threads = " << m.threads;

@@ -11,14 +11,14 @@ namespace tomomap::daemon {
 enum class LogLevel { Debug, Info, Warning, Error };
 
 struct Config {
-  std::string file;                  ///< where it was read from
+  std::string file;                      ///< where it was read from
   transport::TransportConfig transport;  ///< agent id, domain, address, ports, peers, bandwidth
-  std::string map;                   ///< own map file (absolute, or relative to the config file)
-  MatchParams match;                 ///< `grid` and the [match] table; the defaults are MatchParams'
-  std::string output_dir;            ///< transforms.json, status.json
+  std::string map;                       ///< own map file (absolute, or relative to the config file)
+  MatchParams match;                     ///< `grid` and the [match] table; the defaults are MatchParams'
+  std::string output_dir;                ///< transforms.json, status.json
   LogLevel log_level = LogLevel::Info;
-  double claim_timeout_s = 30;       ///< a claim without a result is void after this [s]
-  double request_interval_s = 1;     ///< ask again for missing slices after this much silence [s]
+  double claim_timeout_s = 30;    ///< a claim without a result is void after this [s]
+  double request_interval_s = 1;  ///< ask again for missing slices after this much silence [s]
 
   const std::string& agent() const { return transport.agent; }
   bool isPeer(const std::string& id) const;

@@ -14,8 +14,6 @@
 
 namespace tomomap::daemon {
 
-
-
 class MapSender {
  public:
   /// `bandwidth_kbps`: the flow controller's budget; `grace`: how long after a
@@ -50,7 +48,7 @@ class MapSender {
   transport::MapOffer offer_;
   std::deque<int> queue_;  ///< slices to send, in order
   std::set<int> queued_;
-  size_t next_part_ = 0;   ///< part of queue_.front() to send next
+  size_t next_part_ = 0;  ///< part of queue_.front() to send next
   /// When the flow controller will have sent everything handed to it so far,
   /// and when each slice's last copy leaves.
   Clock::time_point backlog_until_{};

@@ -6,22 +6,27 @@ namespace tomomap::daemon {
 
 const char* stateName(PairState s) {
   switch (s) {
-    case PairState::WaitingForMaps: return "waiting for maps";
-    case PairState::Open: return "open";
-    case PairState::ClaimedByPeer: return "claimed";
-    case PairState::Claimed: return "claimed by us";
-    case PairState::Computing: return "computing";
-    case PairState::Agreed: return "agreed";
-    case PairState::Stale: return "stale";
+    case PairState::WaitingForMaps:
+      return "waiting for maps";
+    case PairState::Open:
+      return "open";
+    case PairState::ClaimedByPeer:
+      return "claimed";
+    case PairState::Claimed:
+      return "claimed by us";
+    case PairState::Computing:
+      return "computing";
+    case PairState::Agreed:
+      return "agreed";
+    case PairState::Stale:
+      return "stale";
   }
   return "?";
 }
 
 PairBoard::PairBoard(std::string me, BoardTimings timings) : me_(std::move(me)), timings_(timings) {}
 
-void PairBoard::mapAnnounced(const std::string& agent, uint64_t version) {
-  maps_[agent] = {version, agent == me_};
-}
+void PairBoard::mapAnnounced(const std::string& agent, uint64_t version) { maps_[agent] = {version, agent == me_}; }
 
 void PairBoard::mapHeld(const std::string& agent) {
   if (const auto it = maps_.find(agent); it != maps_.end()) it->second.held = true;
@@ -53,8 +58,8 @@ bool PairBoard::live(const Claim& c, const PairAt& at, Clock::time_point now) co
 void PairBoard::claimSeen(const std::string& claimer, const PairAt& claim, Clock::time_point now) {
   Claim& held = claims_[claim.pair];
   // Keep the claim that wins: the highest-ranked claimer among live ones.
-  const bool replace = held.claimer.empty() || !outranks(held.claimer, claimer) ||
-                       now - held.seen > timings_.claim_timeout;
+  const bool replace =
+      held.claimer.empty() || !outranks(held.claimer, claimer) || now - held.seen > timings_.claim_timeout;
   if (replace) held = {claimer, claim.target_version, claim.source_version, now};
 }
 
@@ -86,7 +91,13 @@ void PairBoard::leftNetwork() {
 
 BoardStep PairBoard::step(Clock::time_point now) {
   BoardStep out;
-  if (computing_) return out;
+  if (computing_) {
+    if (now - claim_renewed_ >= timings_.claim_timeout / 4) {
+      out.claims.push_back(*computing_);
+      claim_renewed_ = now;
+    }
+    return out;
+  }
   std::vector<std::string> holders;  // in id order: maps_ is sorted
   for (const auto& [id, m] : maps_)
     if (m.held) holders.push_back(id);
@@ -117,6 +128,7 @@ BoardStep PairBoard::step(Clock::time_point now) {
         continue;
       }
       computing_ = at;
+      claim_renewed_ = now;
       out.compute = at;
       return out;
     }

@@ -15,8 +15,6 @@
 
 namespace tomomap::daemon {
 
-
-
 /// The tie-break, written once: of two agents that claim, or computed, the
 /// same pair at the same versions, the one with the lower id wins.
 inline bool outranks(const std::string& a, const std::string& b) { return a < b; }
@@ -50,9 +48,9 @@ struct BoardTimings {
 
 /// What this agent is to do now.
 struct BoardStep {
-  std::vector<PairAt> claims;     ///< publish a claim for each
+  std::vector<PairAt> claims;        ///< publish a claim for each
   std::vector<std::string> yielded;  ///< "pair to claimer", for the log
-  std::optional<PairAt> compute;  ///< start matching this pair
+  std::optional<PairAt> compute;     ///< start matching this pair
 };
 
 class PairBoard {
@@ -88,7 +86,9 @@ class PairBoard {
   // ---- this agent's decisions
   /// Claims pairs whose maps are held and that nobody is on; starts computing
   /// one whose claim has settled and that no higher-ranked claimer contests.
-  /// At most one computation at a time.
+  /// At most one computation at a time; while it runs, its claim is renewed
+  /// every quarter of the claim timeout, so that a match slower than the
+  /// timeout (a big map, a busy machine) is not taken over and done twice.
   BoardStep step(Clock::time_point now);
   /// Our worker's result for the pair being computed: stored (even if the
   /// versions moved on meanwhile: then the pair is stale and is recomputed).
@@ -127,6 +127,7 @@ class PairBoard {
   std::map<PairKey, Claim> claims_;         ///< the winning claim of other agents per pair
   std::map<PairKey, OwnClaim> own_claims_;  ///< pairs we claimed, at which versions, when
   std::optional<PairAt> computing_;
+  Clock::time_point claim_renewed_{};  ///< when the computing pair's claim was last published
   std::map<PairKey, AgreedTransform> results_;
 };
 

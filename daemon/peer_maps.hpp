@@ -17,16 +17,14 @@
 
 namespace tomomap::daemon {
 
-
-
 class PeerMaps {
  public:
   PeerMaps(std::string me, const Log& log) : me_(std::move(me)), log_(log) {}
 
   /// What a new announcement led to.
   struct Announced {
-    bool new_version = false;  ///< false: a version we know already (nothing else happened)
-    bool complete = false;     ///< every slice was kept from the previous version
+    bool new_version = false;                   ///< false: a version we know already (nothing else happened)
+    bool complete = false;                      ///< every slice was kept from the previous version
     std::optional<wire::ChunkRequest> request;  ///< to send to the owner
   };
   /// A validated announcement of a peer's map.
@@ -34,8 +32,8 @@ class PeerMaps {
 
   struct Received {
     transport::Rejection rejection;
-    bool completed = false;   ///< this sample completed the map: features() holds it now
-    bool first = false;       ///< the first sample of this version
+    bool completed = false;  ///< this sample completed the map: features() holds it now
+    bool first = false;      ///< the first sample of this version
   };
   /// A slice sample from its owner (`bytes` on the wire). Samples of versions
   /// not (or no longer) wanted, and of maps already complete, are ignored.

@@ -1,8 +1,20 @@
 #!/usr/bin/env bash
 # The whole test suite from a fresh Debian 12 machine: installs what is missing,
-# builds, and runs every test (unit, CLI, accuracy) with ctest.
+# builds, and runs every test with ctest:
+#  1. a Release build: unit, CLI, accuracy, daemon and install tests (the
+#     `large` label, full-size worlds, is left out: `ctest -L large` runs it);
+#  2. a build with AddressSanitizer and UndefinedBehaviorSanitizer: the unit
+#     and daemon tests again, where any sanitizer report fails the run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+jobs=$(nproc)
+
 scripts/build.sh
-cd "${BUILD_DIR:-build}"
-ctest --output-on-failure -j"$(nproc)" --timeout 1200
+(cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j"$jobs" --timeout 1200 -LE large)
+
+echo "== sanitizer build (ASan + UBSan): unit and daemon tests"
+BUILD_DIR=build-asan BUILD_TYPE=RelWithDebInfo TARGETS="unit_tests daemon_tests tomomapd tomomap" \
+  scripts/build.sh -DTOMOMAP_SANITIZE=ON
+export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+(cd build-asan && ctest --output-on-failure -j"$jobs" --timeout 1200 -L "unit|daemon")

@@ -15,8 +15,9 @@ namespace tomomap::test {
 inline std::string demoRoom() { return TOMOMAP_DEMO_ROOM; }
 inline bool haveDemoRoom() { return std::filesystem::exists(demoRoom() + "/demo-pcd1.pcd"); }
 
-#define REQUIRE_DEMO_ROOM() \
-  if (!::tomomap::test::haveDemoRoom()) GTEST_SKIP() << "demo-room data set not found at " << ::tomomap::test::demoRoom()
+#define REQUIRE_DEMO_ROOM()             \
+  if (!::tomomap::test::haveDemoRoom()) \
+  GTEST_SKIP() << "demo-room data set not found at " << ::tomomap::test::demoRoom()
 
 /// A fresh directory removed when the object goes out of scope.
 struct TempDir {
@@ -63,8 +64,8 @@ struct DemoPair {
 inline DemoPair loadDemoPair() {
   const std::string d = demoRoom() + "/";
   DemoPair p{loadMap(d + "demo-pcd1.pcd"), loadMap(d + "demo-pcd2.pcd"), {}};
-  p.T_1_2 = Pose4::fromMatrix(loadPoseFile(d + "demo-pcd1-gtpose.txt") *
-                              loadPoseFile(d + "demo-pcd2-gtpose.txt").inverse());
+  p.T_1_2 =
+      Pose4::fromMatrix(loadPoseFile(d + "demo-pcd1-gtpose.txt") * loadPoseFile(d + "demo-pcd2-gtpose.txt").inverse());
   return p;
 }
 

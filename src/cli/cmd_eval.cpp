@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include "child_process.hpp"
-#include "core/stats.hpp"
 #include "commands.hpp"
+#include "core/stats.hpp"
 #include "exit_codes.hpp"
 #include "io/map_io.hpp"
 #include "suite.hpp"
@@ -87,8 +87,10 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   const auto& s = j["slices"];
   row.features = s.value("target_features", 0.0) + s.value("source_features", 0.0);
   row.slices = s.value("target", 0.0) + s.value("source", 0.0);
-  row.raw_bytes = static_cast<double>(kPcdBytesPerPoint) * (j.value("target_points", 0.0) + j.value("source_points", 0.0));
-  if (method == "tomomap") row.payload_bytes = static_cast<double>(transport::kFeatureBytes) * row.features + kBytesPerSlice * row.slices;
+  row.raw_bytes =
+      static_cast<double>(kPcdBytesPerPoint) * (j.value("target_points", 0.0) + j.value("source_points", 0.0));
+  if (method == "tomomap")
+    row.payload_bytes = static_cast<double>(transport::kFeatureBytes) * row.features + kBytesPerSlice * row.slices;
   return row;
 }
 
@@ -126,8 +128,8 @@ std::string summary(const std::string& suite, const std::vector<Row>& rows) {
     }
     o << "| " << key.first << " | " << key.second << " | " << g.size() << " | " << ok << "/" << g.size() << " | "
       << std::setprecision(3) << quantile(te, 0.5) << " | " << quantile(te, 0.9) << " | " << std::setprecision(4)
-      << quantile(ye, 0.5) << " | " << quantile(ye, 0.9) << " | " << std::setprecision(2) << quantile(t, 0.5)
-      << " | " << std::setprecision(0) << quantile(m, 1.0) << " | ";
+      << quantile(ye, 0.5) << " | " << quantile(ye, 0.9) << " | " << std::setprecision(2) << quantile(t, 0.5) << " | "
+      << std::setprecision(0) << quantile(m, 1.0) << " | ";
     if (payload > 0 && raw > 0)
       o << std::setprecision(1) << 100.0 * payload / raw << " %";
     else
@@ -153,7 +155,8 @@ cv::Mat boxPlots(const std::vector<Row>& rows, const std::vector<std::string>& m
         noise.push_back(n);
         break;
       }
-  viz::BoxPanel t{"translation error", "error / grid size [cells]", true, 5.0, "success limit 5 cells", noise, methods, {}};
+  viz::BoxPanel t{
+      "translation error", "error / grid size [cells]", true, 5.0, "success limit 5 cells", noise, methods, {}};
   viz::BoxPanel y{"yaw error", "error [deg]", true, 10.0, "success limit 10 deg", noise, methods, {}};
   viz::BoxPanel w{"wall time per pair", "time [s]", true, NAN, "", noise, methods, {}};
   viz::BoxPanel m{"peak memory per pair", "peak RSS [MB]", false, NAN, "", noise, methods, {}};
@@ -164,8 +167,8 @@ cv::Mat boxPlots(const std::vector<Row>& rows, const std::vector<std::string>& m
     w.values[key].push_back(r.seconds);
     m.values[key].push_back(r.peak_rss_mb);
   }
-  return viz::stack({viz::stack({drawBoxPanel(t), drawBoxPanel(y)}, false),
-                     viz::stack({drawBoxPanel(w), drawBoxPanel(m)}, false)});
+  return viz::stack(
+      {viz::stack({drawBoxPanel(t), drawBoxPanel(y)}, false), viz::stack({drawBoxPanel(w), drawBoxPanel(m)}, false)});
 }
 
 struct EvalOptions {
@@ -195,7 +198,8 @@ int runEval(const EvalOptions& o) {
         if (y.grid > 0) name += "-g" + shortNumber(y.grid);
         std::cerr << "generating " << name << "\n";
         const GeneratedWorld w = writeSynthWorld(sp, synth::noiseLevel(noise), (out / "worlds" / name).string());
-        suite.pairs.push_back({name, w.maps[0], w.maps[1], w.poses[0], w.poses[1], y.grid > 0 ? y.grid : w.grid, noise});
+        suite.pairs.push_back(
+            {name, w.maps[0], w.maps[1], w.poses[0], w.poses[1], y.grid > 0 ? y.grid : w.grid, noise});
       }
 
   std::ofstream rows_csv(out / "rows.csv");

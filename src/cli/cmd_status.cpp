@@ -4,7 +4,6 @@
 #include <signal.h>
 
 #include <cerrno>
-
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -44,9 +43,9 @@ json readJson(const std::filesystem::path& path) {
 }
 
 double nowMs() {
-  return static_cast<double>(std::chrono::duration_cast<std::chrono::milliseconds>(
-                                 std::chrono::system_clock::now().time_since_epoch())
-                                 .count());
+  return static_cast<double>(
+      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count());
 }
 
 std::string ago(double ms) {
@@ -76,8 +75,8 @@ void printHuman(const json& status, const json& transforms, bool running) {
                         : "NOT RUNNING")
             << "; status written " << ago(status.value("written_at_ms", 0.0)) << "\n";
   std::cout << "  config   " << status.value("config", "?") << "\n";
-  std::cout << "  map      " << map.value("path", "?") << "\n           version " << map.value("version", "?")
-            << ", " << map.value("slices", 0) << " slices, payload " << kB(map.value("payload_bytes", 0.0)) << " ("
+  std::cout << "  map      " << map.value("path", "?") << "\n           version " << map.value("version", "?") << ", "
+            << map.value("slices", 0) << " slices, payload " << kB(map.value("payload_bytes", 0.0)) << " ("
             << fixed(100.0 * map.value("payload_bytes", 0.0) / std::max(1.0, map.value("raw_bytes", 1.0)), 1)
             << " % of the map's binary PCD)" << (map.value("updating", false) ? ", an update is being described" : "")
             << "\n";
@@ -112,8 +111,8 @@ void printHuman(const json& status, const json& transforms, bool running) {
     std::cout << "\n        support " << t.support << " slice pairs (runner-up " << t.runner_up_support << "), "
               << t.inliers << " inliers; computed by " << t.computed_by << " in " << fixed(t.seconds, 2) << " s, "
               << ago(static_cast<double>(t.computed_at_ms));
-    const bool current = versions.count(t.target) && versions.count(t.source) &&
-                         t.isFor(versions.at(t.target), versions.at(t.source));
+    const bool current =
+        versions.count(t.target) && versions.count(t.source) && t.isFor(versions.at(t.target), versions.at(t.source));
     std::cout << (current ? "" : "; STALE: a map changed since, recomputing") << "\n";
   }
 }
@@ -122,7 +121,7 @@ int runStatus(const StatusOptions& o) {
   const std::filesystem::path dir(o.dir);
   const json status = readJson(dir / "status.json");
   json transforms = std::filesystem::exists(dir / "transforms.json") ? readJson(dir / "transforms.json")
-                                                                      : json{{"transforms", json::array()}};
+                                                                     : json{{"transforms", json::array()}};
   if (!status.contains("map") || !status.contains("peers") || !transforms["transforms"].is_array())
     throw InputError((dir / "status.json").string() + ": not a tomomapd status file");
   const bool fresh = (nowMs() - status.value("written_at_ms", 0.0)) / 1000 < kStaleSeconds;
@@ -144,8 +143,7 @@ Command addStatusCommand(CLI::App& app) {
       "status",
       "Show what a running tomomapd is doing: its map, peers, transfers and agreed transforms.\n"
       "Exit codes: 0 running, 1 not running (the files are from an earlier run), 2 no readable state.");
-  sub->add_option("state_dir", o->dir, "the daemon's output_dir (the service's StateDirectory)")
-      ->capture_default_str();
+  sub->add_option("state_dir", o->dir, "the daemon's output_dir (the service's StateDirectory)")->capture_default_str();
   sub->add_flag("--json", o->json, "print one JSON document for scripts instead of text");
   return {sub, [o] { return runStatus(*o); }};
 }

@@ -11,8 +11,8 @@ namespace tomomap::cli {
 struct SuitePair {
   std::string name;
   std::string target, source, gt_target, gt_source;  ///< paths (resolved against the suite's folder)
-  double grid = MatchParams{}.grid;  ///< [m]
-  std::string noise = "real";  ///< noise label for grouping: real data, or the synth level
+  double grid = MatchParams{}.grid;                  ///< [m]
+  std::string noise = "real";                        ///< noise label for grouping: real data, or the synth level
 };
 
 /// Generated pairs: every seed x noise level of one world type.

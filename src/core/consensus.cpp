@@ -17,8 +17,7 @@ Consensus findConsensus(const std::vector<Rigid2D>& estimates, const ConsensusPa
         weight += weights.empty() ? 1.0 : weights[b];
       }
     }
-    if (group.size() > best.supporters.size() ||
-        (group.size() == best.supporters.size() && weight > best_weight)) {
+    if (group.size() > best.supporters.size() || (group.size() == best.supporters.size() && weight > best_weight)) {
       best.supporters = std::move(group);
       best_weight = weight;
     }

@@ -5,13 +5,13 @@
 namespace tomomap {
 
 struct ConsensusParams {
-  double translation_tolerance = 0.25;  ///< [m]; the matcher sets 5 x grid
+  double translation_tolerance = 0.25;   ///< [m]; the matcher sets 5 x grid
   double yaw_tolerance = radians(10.0);  ///< [rad]
 };
 
 struct Consensus {
-  Rigid2D mean;                   ///< average of the supporters (yaw via mean sin/cos)
-  std::vector<size_t> supporters; ///< indices into the estimates; size() is the support
+  Rigid2D mean;                    ///< average of the supporters (yaw via mean sin/cos)
+  std::vector<size_t> supporters;  ///< indices into the estimates; size() is the support
   size_t support() const { return supporters.size(); }
 };
 

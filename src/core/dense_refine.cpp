@@ -11,8 +11,7 @@ struct PairCells {
   std::vector<Eigen::Vector2d> source;  // source cell centres [m]
 };
 
-std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& source, int offset,
-                                    size_t max_cells) {
+std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& source, int offset, size_t max_cells) {
   size_t total = 0;
   for (int i = 0; i < target.size(); ++i) {
     const int j = i - offset;

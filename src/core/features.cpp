@@ -23,8 +23,8 @@ MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params) {
     if (stack.cells[static_cast<size_t>(k)].empty()) continue;
     // One single-level detector per slice: the images are metric, so there is no
     // scale to search over, and the detector is not thread-safe to share.
-    auto orb = cv::ORB::create(params.max_features, 1.2f, 1, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31,
-                               params.fast_threshold);
+    auto orb =
+        cv::ORB::create(params.max_features, 1.2f, 1, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31, params.fast_threshold);
     const cv::Mat img = stack.image(k, params.pad);
     std::vector<cv::KeyPoint> kps;
     cv::Mat desc;
@@ -35,8 +35,8 @@ MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params) {
     sf.descriptors = desc;
     sf.keypoints.reserve(kps.size());
     for (const auto& kp : kps)
-      sf.keypoints.push_back(stack.grid.toMetres(kp.pt.x - static_cast<float>(params.pad),
-                                                 kp.pt.y - static_cast<float>(params.pad)));
+      sf.keypoints.push_back(
+          stack.grid.toMetres(kp.pt.x - static_cast<float>(params.pad), kp.pt.y - static_cast<float>(params.pad)));
   }
   out.occupancy = std::move(stack);
   for (auto& sf : per_slice)

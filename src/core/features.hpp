@@ -13,15 +13,15 @@ struct FeatureParams {
 };
 
 struct SliceFeatures {
-  int index = 0;                          ///< slice index within its map (0 = lowest kept slice)
-  std::vector<Eigen::Vector2f> keypoints; ///< map-frame x, y [m]
-  cv::Mat descriptors;                    ///< N x 32 CV_8U, 256-bit ORB descriptors
+  int index = 0;                           ///< slice index within its map (0 = lowest kept slice)
+  std::vector<Eigen::Vector2f> keypoints;  ///< map-frame x, y [m]
+  cv::Mat descriptors;                     ///< N x 32 CV_8U, 256-bit ORB descriptors
 };
 
 /// Everything the matcher needs of one map.
 struct MapFeatures {
-  double grid = 0;    ///< slice spacing = grid size [m]
-  double z_min = 0;   ///< height of slice 0 [m]
+  double grid = 0;   ///< slice spacing = grid size [m]
+  double z_min = 0;  ///< height of slice 0 [m]
   int slice_count = 0;
   std::vector<SliceFeatures> slices;  ///< only slices with features, by increasing index
   /// The slices' occupied cells, when available (always offline; over the network

@@ -5,8 +5,8 @@
 
 namespace tomomap {
 
-std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeatures& target,
-                                      const MapFeatures& source, const MatchParams& params) {
+std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeatures& target, const MapFeatures& source,
+                                      const MatchParams& params) {
   // Each (target, source) slice pair belongs to exactly one height offset.
   std::map<int, std::vector<size_t>> by_offset;
   for (size_t k = 0; k < table.estimates.size(); ++k)

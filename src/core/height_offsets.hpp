@@ -10,14 +10,14 @@ namespace tomomap {
 
 /// The consensus found at one height offset.
 struct OffsetScore {
-  int offset = 0;            ///< target slice index - source slice index
-  Consensus consensus;       ///< supporters index SlicePairTable::estimates
-  double inlier_sum = 0;     ///< inliers of the supporting pairs
+  int offset = 0;         ///< target slice index - source slice index
+  Consensus consensus;    ///< supporters index SlicePairTable::estimates
+  double inlier_sum = 0;  ///< inliers of the supporting pairs
 };
 
 /// One score per height offset that has at least one estimate, by offset.
-std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeatures& target,
-                                      const MapFeatures& source, const MatchParams& params);
+std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeatures& target, const MapFeatures& source,
+                                      const MatchParams& params);
 
 struct OffsetChoice {
   const OffsetScore* best = nullptr;  ///< most support, then most inliers; null when there are no scores

@@ -8,17 +8,17 @@
 namespace tomomap {
 
 struct MatchParams {
-  double grid = 0.05;                  ///< voxel, pixel and slice size g [m]; 0.05 indoors, 0.2-0.5 outdoors
+  double grid = 0.05;  ///< voxel, pixel and slice size g [m]; 0.05 indoors, 0.2-0.5 outdoors
   FeatureParams features;
-  double ransac_threshold_cells = 3.0; ///< RANSAC inlier distance [grid cells]
-  int ransac_iterations = 2000;        ///< upper bound per slice pair
+  double ransac_threshold_cells = 3.0;  ///< RANSAC inlier distance [grid cells]
+  int ransac_iterations = 2000;         ///< upper bound per slice pair
   double ransac_confidence = 0.999;
-  int min_matches = 5;                 ///< fewer mutual matches: the slice pair gives no estimate
-  double consensus_translation_cells = 5.0;      ///< [grid cells]
-  double consensus_yaw = radians(10.0);          ///< [rad]
-  int min_support = 3;                 ///< agreeing slice pairs needed for a reliable match
-  int min_inliers = 20;                ///< inlier correspondences needed for a reliable match
-  int threads = 0;                     ///< threads one match uses; 0 = every core
+  int min_matches = 5;                       ///< fewer mutual matches: the slice pair gives no estimate
+  double consensus_translation_cells = 5.0;  ///< [grid cells]
+  double consensus_yaw = radians(10.0);      ///< [rad]
+  int min_support = 3;                       ///< agreeing slice pairs needed for a reliable match
+  int min_inliers = 20;                      ///< inlier correspondences needed for a reliable match
+  int threads = 0;                           ///< threads one match uses; 0 = every core
 };
 
 /// Called with (stage name, done, total) as work advances; may be empty.

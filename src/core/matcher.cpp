@@ -30,8 +30,8 @@ Eigen::Vector3d inlierSpread(const Refined& r) {
 /// "No reliable match" and why, or reliable.
 void judge(MatchResult& r, const MatchParams& params) {
   if (r.support < params.min_support)
-    r.reason = "only " + std::to_string(r.support) + " slice pairs agree (need " + std::to_string(params.min_support) +
-               ")";
+    r.reason =
+        "only " + std::to_string(r.support) + " slice pairs agree (need " + std::to_string(params.min_support) + ")";
   else if (r.inliers < static_cast<size_t>(params.min_inliers))
     r.reason = "only " + std::to_string(r.inliers) + " inlier correspondences (need " +
                std::to_string(params.min_inliers) + ")";
@@ -41,8 +41,7 @@ void judge(MatchResult& r, const MatchParams& params) {
 
 }  // namespace
 
-MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings,
-                        size_t* filtered_points) {
+MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings, size_t* filtered_points) {
   StageTimings local;
   StageTimings& t = timings ? *timings : local;
   auto t0 = Clock::now();
@@ -109,8 +108,7 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   return r;
 }
 
-MatchResult matchMaps(const Points& target, const Points& source, const MatchParams& params,
-                      const Progress& progress) {
+MatchResult matchMaps(const Points& target, const Points& source, const MatchParams& params, const Progress& progress) {
   if (!(params.grid > 0.0) || !std::isfinite(params.grid)) throw InputError("grid size must be a positive number");
   validateMap(target, "target map");
   validateMap(source, "source map");

@@ -31,26 +31,26 @@ struct MatchResult {
   /// must not be used; `reason` says why.
   bool reliable = false;
   std::string reason;
-  Pose4 T_target_source;          ///< p_target = T_target_source * p_source
+  Pose4 T_target_source;  ///< p_target = T_target_source * p_source
 
-  int support = 0;                ///< agreeing slice pairs at the winning height offset
-  int runner_up_support = 0;      ///< best support more than one step away from the winner
-  int height_offset = 0;          ///< winning target slice index - source slice index
-  std::vector<SupportingPair> supporters;  ///< the slice pairs behind `support`, most inliers first
-  size_t inliers = 0;             ///< feature correspondences consistent with the result
+  int support = 0;                                          ///< agreeing slice pairs at the winning height offset
+  int runner_up_support = 0;                                ///< best support more than one step away from the winner
+  int height_offset = 0;                                    ///< winning target slice index - source slice index
+  std::vector<SupportingPair> supporters;                   ///< the slice pairs behind `support`, most inliers first
+  size_t inliers = 0;                                       ///< feature correspondences consistent with the result
   Eigen::Vector3d inlier_spread = Eigen::Vector3d::Zero();  ///< std. dev. of inliers in target x, y, z [m]
 
   int target_slices = 0, source_slices = 0;
   size_t target_features = 0, source_features = 0;
-  size_t slice_pairs = 0;          ///< slice pairs matched (n_target x n_source with features)
+  size_t slice_pairs = 0;  ///< slice pairs matched (n_target x n_source with features)
   StageTimings timings;
 };
 
 /// Finds T_target_source from two feature stacks of the same grid size: slice
 /// pairs estimated (slice_pairs.hpp), height offsets scored and the best picked
 /// (height_offsets.hpp), the winner refined (refine.hpp), the answer judged.
-MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source,
-                          const MatchParams& params, const Progress& progress = {});
+MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
+                          const Progress& progress = {});
 
 /// Voxel filter, slicing, features and matching for two raw maps.
 MatchResult matchMaps(const Points& target, const Points& source, const MatchParams& params,

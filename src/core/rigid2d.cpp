@@ -47,8 +47,7 @@ std::vector<uint32_t> collectInliers(const Correspondences& c, const Rigid2D& T,
   return in;
 }
 
-std::optional<RigidEstimate> ransacRigid2D(const Correspondences& c, const RansacParams& params,
-                                           uint64_t seed) {
+std::optional<RigidEstimate> ransacRigid2D(const Correspondences& c, const RansacParams& params, uint64_t seed) {
   const size_t n = c.size();
   if (n < 2 || n < static_cast<size_t>(params.min_inliers)) return std::nullopt;
   std::mt19937_64 rng(seed);
@@ -69,8 +68,8 @@ std::optional<RigidEstimate> ransacRigid2D(const Correspondences& c, const Ransa
     Rigid2D T;
     T.yaw = std::atan2(dt.y(), dt.x()) - std::atan2(ds.y(), ds.x());
     const double co = std::cos(T.yaw), si = std::sin(T.yaw);
-    T.t = c.target[a] - Eigen::Vector2d(co * c.source[a].x() - si * c.source[a].y(),
-                                        si * c.source[a].x() + co * c.source[a].y());
+    T.t = c.target[a] -
+          Eigen::Vector2d(co * c.source[a].x() - si * c.source[a].y(), si * c.source[a].x() + co * c.source[a].y());
     size_t count = 0;
     for (size_t i = 0; i < n; ++i) {
       const Eigen::Vector2d r(co * c.source[i].x() - si * c.source[i].y() + T.t.x() - c.target[i].x(),

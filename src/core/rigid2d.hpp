@@ -8,7 +8,7 @@
 namespace tomomap {
 
 struct Rigid2D {
-  double yaw = 0;                        ///< [rad]
+  double yaw = 0;                               ///< [rad]
   Eigen::Vector2d t = Eigen::Vector2d::Zero();  ///< [m]
 
   Eigen::Vector2d apply(const Eigen::Vector2d& p) const {
@@ -26,12 +26,12 @@ struct RansacParams {
   double inlier_threshold = 0.15;  ///< [m]; the matcher sets 3 x grid
   int max_iterations = 2000;
   double confidence = 0.999;
-  int min_inliers = 3;             ///< fewer inliers: no estimate
+  int min_inliers = 3;  ///< fewer inliers: no estimate
 };
 
 struct RigidEstimate {
-  Rigid2D transform;             ///< maps source onto target
-  std::vector<uint32_t> inliers; ///< indices into the correspondences
+  Rigid2D transform;              ///< maps source onto target
+  std::vector<uint32_t> inliers;  ///< indices into the correspondences
 };
 
 /// Least-squares rigid fit of the selected correspondences (all of them when
@@ -56,8 +56,7 @@ RigidEstimate refineLeastSquares(const Correspondences& c, RigidEstimate start, 
 
 /// RANSAC on two-point samples, then least-squares refinement on the inliers
 /// (re-collecting inliers until they stop changing). `seed` makes it repeatable.
-std::optional<RigidEstimate> ransacRigid2D(const Correspondences& c, const RansacParams& params,
-                                           uint64_t seed);
+std::optional<RigidEstimate> ransacRigid2D(const Correspondences& c, const RansacParams& params, uint64_t seed);
 
 /// Indices of correspondences that `T` maps within `threshold` [m].
 std::vector<uint32_t> collectInliers(const Correspondences& c, const Rigid2D& T, double threshold);

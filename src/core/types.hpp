@@ -39,9 +39,13 @@ struct Pose4 {
   Eigen::Matrix4d matrix() const {
     Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
     const double c = std::cos(yaw), s = std::sin(yaw);
-    m(0, 0) = c; m(0, 1) = -s;
-    m(1, 0) = s; m(1, 1) = c;
-    m(0, 3) = x; m(1, 3) = y; m(2, 3) = z;
+    m(0, 0) = c;
+    m(0, 1) = -s;
+    m(1, 0) = s;
+    m(1, 1) = c;
+    m(0, 3) = x;
+    m(1, 3) = y;
+    m(2, 3) = z;
     return m;
   }
 
@@ -55,8 +59,8 @@ struct Pose4 {
 
   Eigen::Vector3f apply(const Eigen::Vector3f& p) const {
     const double c = std::cos(yaw), s = std::sin(yaw);
-    return {static_cast<float>(c * p.x() - s * p.y() + x),
-            static_cast<float>(s * p.x() + c * p.y() + y), static_cast<float>(p.z() + z)};
+    return {static_cast<float>(c * p.x() - s * p.y() + x), static_cast<float>(s * p.x() + c * p.y() + y),
+            static_cast<float>(p.z() + z)};
   }
 };
 
@@ -75,8 +79,7 @@ struct PoseError {
 };
 
 inline PoseError poseError(const Pose4& estimate, const Pose4& reference) {
-  const double dx = estimate.x - reference.x, dy = estimate.y - reference.y,
-               dz = estimate.z - reference.z;
+  const double dx = estimate.x - reference.x, dy = estimate.y - reference.y, dz = estimate.z - reference.z;
   return {std::sqrt(dx * dx + dy * dy + dz * dz), std::abs(wrapAngle(estimate.yaw - reference.yaw))};
 }
 

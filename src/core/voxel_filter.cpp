@@ -28,8 +28,7 @@ Points voxelFilter(const Points& in, double leaf) {
   for (size_t b = 0; b < keyed.size();) {
     size_t e = b;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e)
-      sum += in[keyed[e].second].cast<double>();
+    for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e) sum += in[keyed[e].second].cast<double>();
     out.push_back((sum / static_cast<double>(e - b)).cast<float>());
     b = e;
   }

@@ -1,8 +1,5 @@
 #include "map_io.hpp"
 
-#include "core/map_check.hpp"
-#include "pcd_check.hpp"
-
 #include <pcl/common/io.h>
 #include <pcl/console/print.h>
 #include <pcl/io/pcd_io.h>
@@ -16,6 +13,9 @@
 #include <fstream>
 #include <iomanip>
 #include <sstream>
+
+#include "core/map_check.hpp"
+#include "pcd_check.hpp"
 
 namespace tomomap {
 namespace {
@@ -88,11 +88,12 @@ Points loadXyz(const std::string& path) {
     double x, y, z;
     // Reading via strings lets "nan"/"inf" through to the finiteness check below.
     std::string sx, sy, sz;
-    if (!(fields >> sx >> sy >> sz))
-      throw InputError(path + ":" + std::to_string(number) + ": expected 'x y z'");
+    if (!(fields >> sx >> sy >> sz)) throw InputError(path + ":" + std::to_string(number) + ": expected 'x y z'");
     try {
       size_t px, py, pz;
-      x = std::stod(sx, &px); y = std::stod(sy, &py); z = std::stod(sz, &pz);
+      x = std::stod(sx, &px);
+      y = std::stod(sy, &py);
+      z = std::stod(sz, &pz);
       if (px != sx.size() || py != sy.size() || pz != sz.size()) throw std::invalid_argument("");
     } catch (const std::exception&) {
       throw InputError(path + ":" + std::to_string(number) + ": not a number in '" + line + "'");
@@ -112,10 +113,14 @@ Points loadMap(const std::string& path) {
 
   const std::string ext = lowerExtension(path);
   Points points;
-  if (ext == ".pcd") points = loadPcl(path, false);
-  else if (ext == ".ply") points = loadPcl(path, true);
-  else if (ext == ".xyz" || ext == ".txt") points = loadXyz(path);
-  else throw InputError(path + ": unknown map format '" + ext + "' (use .pcd, .ply, .xyz or .txt)");
+  if (ext == ".pcd")
+    points = loadPcl(path, false);
+  else if (ext == ".ply")
+    points = loadPcl(path, true);
+  else if (ext == ".xyz" || ext == ".txt")
+    points = loadXyz(path);
+  else
+    throw InputError(path + ": unknown map format '" + ext + "' (use .pcd, .ply, .xyz or .txt)");
   validateMap(points, path);
   return points;
 }
@@ -145,14 +150,12 @@ Eigen::Matrix4d loadPoseFile(const std::string& path) {
     if (!std::isfinite(v.back())) throw InputError(path + ": pose file has a non-finite number");
   }
   if (v.size() != 12)
-    throw InputError(path + ": pose file must hold 12 numbers (3x4 row-major), found " +
-                     std::to_string(v.size()));
+    throw InputError(path + ": pose file must hold 12 numbers (3x4 row-major), found " + std::to_string(v.size()));
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) m(r, c) = v[static_cast<size_t>(r * 4 + c)];
   const Eigen::Matrix3d R = m.topLeftCorner<3, 3>();
-  if (!(R.transpose() * R).isIdentity(1e-3))
-    throw InputError(path + ": pose rotation is not orthonormal");
+  if (!(R.transpose() * R).isIdentity(1e-3)) throw InputError(path + ": pose rotation is not orthonormal");
   return m;
 }
 

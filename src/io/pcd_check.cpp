@@ -44,12 +44,18 @@ void checkPcdIntegrity(const std::string& path) {
     if (key == "FIELDS" || key == "TYPE") {
       size_t& n_of = key == "FIELDS" ? fields_n : types_n;
       for (std::string f; fields >> f;) ++n_of;
-    } else if (key == "SIZE") sizes = numbers(fields);
-    else if (key == "COUNT") counts = numbers(fields);
-    else if (key == "POINTS") points = numbers(fields).at(0);
-    else if (key == "WIDTH") width = numbers(fields).at(0);
-    else if (key == "HEIGHT") height = numbers(fields).at(0);
-    else if (key == "DATA") fields >> data;
+    } else if (key == "SIZE")
+      sizes = numbers(fields);
+    else if (key == "COUNT")
+      counts = numbers(fields);
+    else if (key == "POINTS")
+      points = numbers(fields).at(0);
+    else if (key == "WIDTH")
+      width = numbers(fields).at(0);
+    else if (key == "HEIGHT")
+      height = numbers(fields).at(0);
+    else if (key == "DATA")
+      fields >> data;
   }
   if (data.empty()) fail("not a PCD file (no DATA line in the header)");
   if (counts.empty()) counts.assign(sizes.size(), 1);
@@ -79,8 +85,7 @@ void checkPcdIntegrity(const std::string& path) {
   in.seekg(data_start);
   in.read(reinterpret_cast<char*>(&packed), 4);
   in.read(reinterpret_cast<char*>(&unpacked), 4);
-  if (!in || available < 8 + static_cast<long>(packed))
-    fail("truncated: compressed data cut short");
+  if (!in || available < 8 + static_cast<long>(packed)) fail("truncated: compressed data cut short");
   if (static_cast<long>(unpacked) != expected)
     fail("corrupt: compressed data holds " + std::to_string(unpacked) + " bytes, header promises " +
          std::to_string(expected));

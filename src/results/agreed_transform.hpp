@@ -26,16 +26,16 @@ uint64_t parseVersion(const std::string& text);
 struct AgreedTransform {
   std::string target, source;
   uint64_t target_version = 0, source_version = 0;  ///< the maps' versions it was computed for
-  bool reliable = false;             ///< false: computed, no reliable match (T is then meaningless)
-  std::string reason;                ///< why not, when not reliable
-  Pose4 T_target_source;             ///< p_target = T_target_source * p_source
-  int support = 0;                   ///< agreeing slice pairs
+  bool reliable = false;                            ///< false: computed, no reliable match (T is then meaningless)
+  std::string reason;                               ///< why not, when not reliable
+  Pose4 T_target_source;                            ///< p_target = T_target_source * p_source
+  int support = 0;                                  ///< agreeing slice pairs
   int runner_up_support = 0;
   uint32_t inliers = 0;
-  std::array<double, 3> spread{};    ///< std. dev. of the inliers in target x, y, z [m]
+  std::array<double, 3> spread{};  ///< std. dev. of the inliers in target x, y, z [m]
   std::string computed_by;
-  uint64_t computed_at_ms = 0;       ///< the computing agent's wall clock [ms since the epoch]
-  double seconds = 0;                ///< matching time [s]
+  uint64_t computed_at_ms = 0;  ///< the computing agent's wall clock [ms since the epoch]
+  double seconds = 0;           ///< matching time [s]
 
   PairKey pair() const { return {target, source}; }
   /// Computed for exactly these versions of the two maps.

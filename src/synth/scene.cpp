@@ -107,8 +107,10 @@ Scene indoorScene(const SceneParams& p) {
         furnish(w, rng, r, z0);
         floors[static_cast<size_t>(f)].push_back(r);
       }
-      if (side == 0) wallAlongX(w, 0, W, yc0 - kWall, yc0, z0, doors);
-      else wallAlongX(w, 0, W, yc1, yc1 + kWall, z0, doors);
+      if (side == 0)
+        wallAlongX(w, 0, W, yc0 - kWall, yc0, z0, doors);
+      else
+        wallAlongX(w, 0, W, yc1, yc1 + kWall, z0, doors);
     }
     // A few columns in the corridor break its symmetry.
     for (double x = uniform(rng, 2, 6); x < W - 1; x += uniform(rng, 5, 9))
@@ -149,7 +151,11 @@ Scene outdoorScene(const SceneParams& p) {
   s.sensor = {32, -0.44, 0.27, 720, 50.0};
   World& w = s.world;
   const double L = 120.0 * p.scale, half_street = 6.0, sidewalk = 2.5;
-  w.ground = {true, uniform(rng, 0.2, 0.5), uniform(rng, 8, 14), uniform(rng, 0.1, 0.3), uniform(rng, 6, 10),
+  w.ground = {true,
+              uniform(rng, 0.2, 0.5),
+              uniform(rng, 8, 14),
+              uniform(rng, 0.1, 0.3),
+              uniform(rng, 6, 10),
               uniform(rng, -0.02, 0.02)};
   const Ground& g = w.ground;
 
@@ -164,7 +170,8 @@ Scene outdoorScene(const SceneParams& p) {
       const double setback = uniform(rng, 0, 2.0), depth = uniform(rng, 8, 15), height = uniform(rng, 6, 25);
       const double y_near = side * (half_street + sidewalk + setback), y_far = y_near + side * depth;
       const double base = g.height(x + width / 2, y_near) - 3.0;
-      w.boxes.push_back({V3(x, std::min(y_near, y_far), base), V3(x + width - 0.3, std::max(y_near, y_far), base + 3 + height)});
+      w.boxes.push_back(
+          {V3(x, std::min(y_near, y_far), base), V3(x + width - 0.3, std::max(y_near, y_far), base + 3 + height)});
       // A ground-floor canopy or balcony row on some facades.
       if (uniform(rng, 0, 1) < 0.4) {
         const double zc = base + 3 + uniform(rng, 3, 5);

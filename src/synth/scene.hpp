@@ -16,19 +16,19 @@ std::string toString(WorldType type);
 
 /// A spinning multi-beam range sensor.
 struct SensorModel {
-  int beams = 32;              ///< vertical channels
-  double elevation_min = -0.7; ///< [rad]
-  double elevation_max = 0.7;  ///< [rad]
-  int azimuth_steps = 360;     ///< readings per revolution per beam
-  double max_range = 10.0;     ///< [m]
+  int beams = 32;               ///< vertical channels
+  double elevation_min = -0.7;  ///< [rad]
+  double elevation_max = 0.7;   ///< [rad]
+  int azimuth_steps = 360;      ///< readings per revolution per beam
+  double max_range = 10.0;      ///< [m]
 };
 
 struct Scene {
   World world;
   SensorModel sensor;
   std::vector<std::vector<Pose4>> trajectories;  ///< sensor poses in the world, one list per map
-  double grid = 0.05;            ///< grid size the scene is meant to be matched at [m]
-  double map_resolution = 0.02;  ///< voxel size the generated maps are stored at [m]
+  double grid = 0.05;                            ///< grid size the scene is meant to be matched at [m]
+  double map_resolution = 0.02;                  ///< voxel size the generated maps are stored at [m]
 };
 
 struct SceneParams {

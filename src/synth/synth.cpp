@@ -36,7 +36,8 @@ std::vector<SynthMap> scanScene(const Scene& scene, const NoiseModel& noise, uin
     const auto& traj = scene.trajectories[m];
     // The map frame starts at the robot's first pose, with an arbitrary heading.
     const Pose4& start = traj.front();
-    const Pose4 P{start.x, start.y, start.z, wrapAngle(start.yaw + std::uniform_real_distribution<double>(-kPi, kPi)(frame_rng))};
+    const Pose4 P{start.x, start.y, start.z,
+                  wrapAngle(start.yaw + std::uniform_real_distribution<double>(-kPi, kPi)(frame_rng))};
     const Pose4 world_to_map = P.inverse();
 
     std::vector<Points> per_scan(traj.size());

@@ -18,7 +18,7 @@ struct NoiseModel {
 NoiseModel noiseLevel(const std::string& name);
 
 struct SynthMap {
-  Points points;          ///< in the map frame, voxel-filtered at the scene's map resolution
+  Points points;  ///< in the map frame, voxel-filtered at the scene's map resolution
   /// Ground truth in the convention of the shared datasets (demo-room): the
   /// world -> map matrix, so that T_target_source = pose_target * pose_source^-1.
   Eigen::Matrix4d pose;

@@ -64,9 +64,7 @@ double hitGround(const Ground& g, const Eigen::Vector3d& o, const Eigen::Vector3
 
 }  // namespace
 
-double Ground::height(double x, double y) const {
-  return a1 * std::sin(x / l1) + a2 * std::cos(y / l2) + slope * x;
-}
+double Ground::height(double x, double y) const { return a1 * std::sin(x / l1) + a2 * std::cos(y / l2) + slope * x; }
 
 double Ground::maxSlope() const { return std::abs(a1 / l1) + std::abs(a2 / l2) + std::abs(slope); }
 
@@ -84,8 +82,8 @@ NearbySolids solidsNear(const World& world, const Eigen::Vector3d& origin, doubl
   return n;
 }
 
-double castRay(const World& world, const NearbySolids& near, const Eigen::Vector3d& origin,
-               const Eigen::Vector3d& dir, double max_range) {
+double castRay(const World& world, const NearbySolids& near, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+               double max_range) {
   double best = max_range;
   for (const Box* b : near.boxes) best = std::min(best, hitBox(*b, origin, dir));
   for (const Cylinder* c : near.cylinders) best = std::min(best, hitCylinder(*c, origin, dir));

@@ -45,7 +45,7 @@ NearbySolids solidsNear(const World& world, const Eigen::Vector3d& origin, doubl
 
 /// Distance along the unit direction `dir` to the first surface, or +inf if
 /// nothing is hit within `max_range`.
-double castRay(const World& world, const NearbySolids& near, const Eigen::Vector3d& origin,
-               const Eigen::Vector3d& dir, double max_range);
+double castRay(const World& world, const NearbySolids& near, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
+               double max_range);
 
 }  // namespace tomomap::synth

@@ -1,5 +1,6 @@
 #include "bus.hpp"
 
+#include <algorithm>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
@@ -9,7 +10,6 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
-#include <algorithm>
 #include <stdexcept>
 
 #include "tomomapPubSubTypes.h"
@@ -39,7 +39,8 @@ class Listener : public DataReaderListener {
 class ParticipantWatch : public DomainParticipantListener {
  public:
   explicit ParticipantWatch(std::function<void(const std::string&, bool)> on) : on_(std::move(on)) {}
-  void on_participant_discovery(DomainParticipant*, eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+  void on_participant_discovery(DomainParticipant*,
+                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
     using S = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
     if (!on_) return;
     const std::string name = info.info.m_participantName.to_string();
@@ -96,8 +97,7 @@ struct Bus::Impl {
   Subscriber* subscriber = nullptr;
   std::unique_ptr<ParticipantWatch> watch;
   std::vector<std::unique_ptr<DataReaderListener>> listeners;
-  DataWriter *announcements = nullptr, *slices = nullptr, *requests = nullptr, *claims = nullptr,
-             *estimates = nullptr;
+  DataWriter *announcements = nullptr, *slices = nullptr, *requests = nullptr, *claims = nullptr, *estimates = nullptr;
 
   template <typename PubSub, typename T>
   DataWriter* addTopic(const std::string& name, const TopicQos& tq, std::function<void(T&&)> on,
@@ -143,10 +143,10 @@ Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<
           if (on) on(std::move(s), bytes);
         },
         /*flow_controlled=*/true);
-    i.requests = i.addTopic<wire::ChunkRequestPubSubType, wire::ChunkRequest>(
-        "tomomap/requests", {false, true, 1, 256, 1}, h.request);
-    i.claims = i.addTopic<wire::MatchClaimPubSubType, wire::MatchClaim>("tomomap/claims", {false, false, 1, 0, 1024},
-                                                                       h.claim);
+    i.requests = i.addTopic<wire::ChunkRequestPubSubType, wire::ChunkRequest>("tomomap/requests",
+                                                                              {false, true, 1, 256, 1}, h.request);
+    i.claims =
+        i.addTopic<wire::MatchClaimPubSubType, wire::MatchClaim>("tomomap/claims", {false, false, 1, 0, 1024}, h.claim);
     i.estimates = i.addTopic<wire::TransformEstimatePubSubType, wire::TransformEstimate>(
         "tomomap/estimates", {true, false, 1, 0, 1024}, h.estimate);
   } catch (...) {
@@ -163,7 +163,9 @@ Bus::~Bus() {
   DomainParticipantFactory::get_instance()->delete_participant(i.participant);
 }
 
-bool Bus::publish(const wire::MapAnnouncement& a) { return impl_->announcements->write(const_cast<wire::MapAnnouncement*>(&a)); }
+bool Bus::publish(const wire::MapAnnouncement& a) {
+  return impl_->announcements->write(const_cast<wire::MapAnnouncement*>(&a));
+}
 bool Bus::publish(const wire::SliceFeatures& s) { return impl_->slices->write(const_cast<wire::SliceFeatures*>(&s)); }
 bool Bus::publish(const wire::ChunkRequest& r) { return impl_->requests->write(const_cast<wire::ChunkRequest*>(&r)); }
 bool Bus::publish(const wire::MatchClaim& c) { return impl_->claims->write(const_cast<wire::MatchClaim*>(&c)); }

@@ -48,10 +48,12 @@ std::vector<wire::SliceFeatures> cutSlice(const std::string& agent, const SliceF
   };
   if (as_cells) {
     const auto parts = split(deflated, bytes_per_part);
-    for (size_t p = 0; p < parts.size(); ++p) samples.push_back(base(p, parts.size())), samples.back().occupancy(parts[p]);
+    for (size_t p = 0; p < parts.size(); ++p)
+      samples.push_back(base(p, parts.size())), samples.back().occupancy(parts[p]);
   } else {
     const auto parts = split(feats, features_per_part);
-    for (size_t p = 0; p < parts.size(); ++p) samples.push_back(base(p, parts.size())), samples.back().features(parts[p]);
+    for (size_t p = 0; p < parts.size(); ++p)
+      samples.push_back(base(p, parts.size())), samples.back().features(parts[p]);
   }
   return samples;
 }
@@ -91,8 +93,8 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const Feature
   if (order.size() > wire::MAX_SLICES) order.resize(wire::MAX_SLICES);
 
   for (const SliceFeatures* s : order) {
-    auto samples = cutSlice(agent, *s, f.occupancy.cells.at(static_cast<size_t>(s->index)), g, features_per_part,
-                            bytes_per_part);
+    auto samples =
+        cutSlice(agent, *s, f.occupancy.cells.at(static_cast<size_t>(s->index)), g, features_per_part, bytes_per_part);
     const auto bytes = canonicalBytes(samples);
     wire::SliceEntry e;
     e.slice(s->index);

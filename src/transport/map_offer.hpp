@@ -14,7 +14,7 @@ namespace tomomap::transport {
 struct MapOffer {
   wire::MapAnnouncement announcement;
   std::map<int, std::vector<wire::SliceFeatures>> samples;  ///< by slice index, parts in order
-  size_t payload_bytes = 0;  ///< sum of the slices' payload bytes
+  size_t payload_bytes = 0;                                 ///< sum of the slices' payload bytes
 };
 
 /// Slices `features` (its occupancy must be present; `params` are the ones it

@@ -1,13 +1,13 @@
 #include "participant.hpp"
 
-#include <fastdds/dds/domain/DomainParticipant.hpp>
-#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
-#include <fastdds/rtps/flowcontrol/FlowControllerDescriptor.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
 #include <algorithm>
 #include <cmath>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/rtps/flowcontrol/FlowControllerDescriptor.hpp>
 #include <memory>
 #include <stdexcept>
 
@@ -70,9 +70,8 @@ DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipant
   flow->period_ms = kFlowPeriodMs;
   q.flow_controllers().push_back(flow);
 
-  DomainParticipant* p =
-      DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(c.domain), q, listener,
-                                                                 StatusMask::none());
+  DomainParticipant* p = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(c.domain),
+                                                                                      q, listener, StatusMask::none());
   if (!p)
     throw std::runtime_error("cannot create the DDS participant (ports " + std::to_string(c.discovery_port) + "/" +
                              std::to_string(c.data_port) + " on " + c.address + " in use?)");

@@ -9,14 +9,14 @@
 namespace eprosima::fastdds::dds {
 class DomainParticipant;
 class DomainParticipantListener;
-}
+}  // namespace eprosima::fastdds::dds
 
 namespace tomomap::transport {
 
 struct PeerAddress {
   std::string id;
-  std::string host;            ///< IPv4 address
-  uint16_t port = 0;           ///< the peer's discovery port
+  std::string host;   ///< IPv4 address
+  uint16_t port = 0;  ///< the peer's discovery port
 };
 
 struct TransportConfig {
@@ -26,7 +26,7 @@ struct TransportConfig {
   uint16_t discovery_port = 0;
   uint16_t data_port = 0;
   std::vector<PeerAddress> peers;
-  double bandwidth_kbps = 10000;     ///< budget for slice data [kbit/s]
+  double bandwidth_kbps = 10000;  ///< budget for slice data [kbit/s]
 };
 
 /// Flow-controller period [ms]: the budget is enforced per period.

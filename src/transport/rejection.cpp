@@ -4,24 +4,42 @@ namespace tomomap::transport {
 
 std::string Rejection::text() const {
   switch (why) {
-    case Reject::None: return "";
-    case Reject::BadGridOrOrigin: return "announcement with a bad grid or origin";
-    case Reject::BadRaster: return "announcement with a bad raster size";
-    case Reject::BadSliceCount: return "announcement with a bad slice count";
-    case Reject::SliceOutOfRange: return "announcement lists slice " + std::to_string(slice) + " out of range or twice";
-    case Reject::BadPartCount: return "announcement with a bad part count";
-    case Reject::OversizedSlice: return "announcement with an oversized slice";
-    case Reject::BadFeatureSettings: return "announcement with feature settings out of range";
-    case Reject::VersionMismatch: return "announcement whose version does not match its content";
-    case Reject::NotAnnounced: return "slice " + std::to_string(slice) + " was not announced";
-    case Reject::PartNumbering: return "part numbering differs from the announcement";
-    case Reject::MixedEncoding: return "sample mixes encodings";
-    case Reject::KeypointOutside: return "keypoint outside the raster";
-    case Reject::LargerThanAnnounced: return "slice larger than announced";
-    case Reject::ChecksumMismatch: return "slice checksum mismatch";
-    case Reject::NotInflating: return "occupancy does not inflate to the announced raster";
-    case Reject::UnorderedPair: return "estimate with an unordered pair";
-    case Reject::NonFiniteTransform: return "estimate with a non-finite transform";
+    case Reject::None:
+      return "";
+    case Reject::BadGridOrOrigin:
+      return "announcement with a bad grid or origin";
+    case Reject::BadRaster:
+      return "announcement with a bad raster size";
+    case Reject::BadSliceCount:
+      return "announcement with a bad slice count";
+    case Reject::SliceOutOfRange:
+      return "announcement lists slice " + std::to_string(slice) + " out of range or twice";
+    case Reject::BadPartCount:
+      return "announcement with a bad part count";
+    case Reject::OversizedSlice:
+      return "announcement with an oversized slice";
+    case Reject::BadFeatureSettings:
+      return "announcement with feature settings out of range";
+    case Reject::VersionMismatch:
+      return "announcement whose version does not match its content";
+    case Reject::NotAnnounced:
+      return "slice " + std::to_string(slice) + " was not announced";
+    case Reject::PartNumbering:
+      return "part numbering differs from the announcement";
+    case Reject::MixedEncoding:
+      return "sample mixes encodings";
+    case Reject::KeypointOutside:
+      return "keypoint outside the raster";
+    case Reject::LargerThanAnnounced:
+      return "slice larger than announced";
+    case Reject::ChecksumMismatch:
+      return "slice checksum mismatch";
+    case Reject::NotInflating:
+      return "occupancy does not inflate to the announced raster";
+    case Reject::UnorderedPair:
+      return "estimate with an unordered pair";
+    case Reject::NonFiniteTransform:
+      return "estimate with a non-finite transform";
   }
   return "unknown rejection";
 }

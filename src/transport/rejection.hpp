@@ -8,22 +8,22 @@ namespace tomomap::transport {
 
 enum class Reject {
   None,
-  BadGridOrOrigin,     ///< announcement: grid not positive or origin not finite
-  BadRaster,           ///< announcement: width or height 0 or above the image cap
+  BadGridOrOrigin,  ///< announcement: grid not positive or origin not finite
+  BadRaster,        ///< announcement: width or height 0 or above the image cap
   BadSliceCount,
-  SliceOutOfRange,     ///< announcement lists a slice out of range or twice
+  SliceOutOfRange,  ///< announcement lists a slice out of range or twice
   BadPartCount,
-  OversizedSlice,      ///< announcement: a slice larger than any real slice can be
+  OversizedSlice,  ///< announcement: a slice larger than any real slice can be
   BadFeatureSettings,
-  VersionMismatch,     ///< announcement whose version is not the hash of its content
-  NotAnnounced,        ///< sample of a slice the announcement does not list
+  VersionMismatch,  ///< announcement whose version is not the hash of its content
+  NotAnnounced,     ///< sample of a slice the announcement does not list
   PartNumbering,
   MixedEncoding,
   KeypointOutside,
   LargerThanAnnounced,
   ChecksumMismatch,
-  NotInflating,        ///< occupancy that does not inflate to the announced raster
-  UnorderedPair,       ///< estimate whose target id is not below its source id
+  NotInflating,   ///< occupancy that does not inflate to the announced raster
+  UnorderedPair,  ///< estimate whose target id is not below its source id
   NonFiniteTransform,
 };
 

@@ -31,8 +31,7 @@ std::vector<uint8_t> deflateCells(const std::vector<uint32_t>& cells, int width,
 std::optional<std::vector<uint32_t>> inflateCells(const std::vector<uint8_t>& bytes, int width, int height) {
   std::vector<uint8_t> raster(rasterBytes(static_cast<size_t>(width), static_cast<size_t>(height)));
   uLongf size = static_cast<uLongf>(raster.size());
-  if (uncompress(raster.data(), &size, bytes.data(), static_cast<uLong>(bytes.size())) != Z_OK ||
-      size != raster.size())
+  if (uncompress(raster.data(), &size, bytes.data(), static_cast<uLong>(bytes.size())) != Z_OK || size != raster.size())
     return std::nullopt;
   std::vector<uint32_t> cells;
   const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);

@@ -1,11 +1,12 @@
 #include "canvas.hpp"
 
+#include <png.h>
+
 #include <algorithm>
 #include <cmath>
-#include <png.h>
+#include <iomanip>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
-#include <iomanip>
 
 #include "core/types.hpp"
 
@@ -38,17 +39,19 @@ void drawDashedLine(cv::Mat& img, cv::Point a, cv::Point b, const cv::Scalar& c,
   const double length = std::hypot(b.x - a.x, b.y - a.y);
   for (double s = 0; s < length; s += 2 * dash) {
     const double e = std::min(length, s + dash);
-    const cv::Point p(a.x + static_cast<int>((b.x - a.x) * s / length), a.y + static_cast<int>((b.y - a.y) * s / length));
-    const cv::Point q(a.x + static_cast<int>((b.x - a.x) * e / length), a.y + static_cast<int>((b.y - a.y) * e / length));
+    const cv::Point p(a.x + static_cast<int>((b.x - a.x) * s / length),
+                      a.y + static_cast<int>((b.y - a.y) * s / length));
+    const cv::Point q(a.x + static_cast<int>((b.x - a.x) * e / length),
+                      a.y + static_cast<int>((b.y - a.y) * e / length));
     cv::line(img, p, q, c, thickness, cv::LINE_AA);
   }
 }
 
 ValueAxis ValueAxis::fit(std::vector<double> values, bool log, int top, int bottom, double also) {
   if (std::isfinite(also)) values.push_back(also);
-  values.erase(std::remove_if(values.begin(), values.end(),
-                              [log](double v) { return !std::isfinite(v) || (log && v <= 0); }),
-               values.end());
+  values.erase(
+      std::remove_if(values.begin(), values.end(), [log](double v) { return !std::isfinite(v) || (log && v <= 0); }),
+      values.end());
   ValueAxis a;
   a.log = log;
   a.top = top;

@@ -23,8 +23,7 @@ void drawText(cv::Mat& img, const std::string& text, cv::Point at, double scale 
 /// Same, rotated 90 degrees counter-clockwise (for a y-axis label), centred on `centre`.
 void drawVerticalText(cv::Mat& img, const std::string& text, cv::Point centre, double scale = 0.5);
 
-void drawDashedLine(cv::Mat& img, cv::Point a, cv::Point b, const cv::Scalar& colour, int thickness = 1,
-                    int dash = 8);
+void drawDashedLine(cv::Mat& img, cv::Point a, cv::Point b, const cv::Scalar& colour, int thickness = 1, int dash = 8);
 
 /// A value axis mapped to pixel rows [top, bottom], linear or logarithmic.
 struct ValueAxis {

@@ -1,12 +1,11 @@
 #include "match_pictures.hpp"
 
-#include "core/rigid2d.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/rigid2d.hpp"
 #include "core/text.hpp"
 
 namespace tomomap::viz {
@@ -64,7 +63,8 @@ cv::Mat drawOverlay(const SliceStack& target, const SliceStack& source, const Po
   // About 1000 pixels across; a cell is drawn as a square of at least one pixel.
   const double px = extent / 1000.0;  // metres per pixel
   const int cell_px = std::max(1, static_cast<int>(std::lround(target.grid.cell / px)));
-  const int w = static_cast<int>((hi.x() - lo.x()) / px) + cell_px, h = static_cast<int>((hi.y() - lo.y()) / px) + cell_px;
+  const int w = static_cast<int>((hi.x() - lo.x()) / px) + cell_px,
+            h = static_cast<int>((hi.y() - lo.y()) / px) + cell_px;
 
   cv::Mat t_mask = cv::Mat::zeros(h, w, CV_8U), s_mask = cv::Mat::zeros(h, w, CV_8U);
   auto plot = [&](const std::vector<Eigen::Vector2d>& xy, cv::Mat& mask) {
@@ -108,8 +108,8 @@ cv::Mat drawOverlay(const SliceStack& target, const SliceStack& source, const Po
   // Legend, under the caption.
   int lx = margin_l;
   const int ly = margin_t - 18;
-  for (const auto& [name, col] : {std::pair<std::string, cv::Vec3b>{"target", blue}, {"source (aligned)", orange},
-                                  {"both", both}}) {
+  for (const auto& [name, col] :
+       {std::pair<std::string, cv::Vec3b>{"target", blue}, {"source (aligned)", orange}, {"both", both}}) {
     cv::rectangle(img, cv::Rect(lx, ly - 11, 14, 12), cv::Scalar(col[0], col[1], col[2]), cv::FILLED);
     drawText(img, name, {lx + 20, ly}, 0.45);
     lx += 40 + 9 * static_cast<int>(name.size());
@@ -183,8 +183,8 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
   cv::Mat out = stack(rows);
   cv::Mat head(40, std::max(out.cols, 1000), CV_8UC3, colour::kWhite);
   drawText(head,
-           "winning height offset " + std::to_string(r.height_offset) + " slices (" +
-               fixed(r.T_target_source.z, 2) + " m), " + std::to_string(r.support) + " agreeing slice pairs",
+           "winning height offset " + std::to_string(r.height_offset) + " slices (" + fixed(r.T_target_source.z, 2) +
+               " m), " + std::to_string(r.support) + " agreeing slice pairs",
            {8, 28}, 0.65, colour::kBlack, Align::Left, 2);
   return stack({head, out});
 }

@@ -15,7 +15,7 @@ cv::Mat drawOverlay(const SliceStack& target, const SliceStack& source, const Po
 /// The `count` supporting slice pairs with the most inliers, target left and
 /// source right, each mutual descriptor match drawn: green if `T_target_source`
 /// maps it within `inlier_cells` grid cells, else not drawn (keypoint grey).
-cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchResult& result,
-                       int count = 3, double inlier_cells = 3.0);
+cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchResult& result, int count = 3,
+                       double inlier_cells = 3.0);
 
 }  // namespace tomomap::viz

@@ -15,8 +15,8 @@ namespace {
 
 std::string demo(const std::string& f) { return test::demoRoom() + "/" + f; }
 std::string demoMatchArgs() {
-  return "match " + demo("demo-pcd1.pcd") + " " + demo("demo-pcd2.pcd") + " --gt-target " + demo("demo-pcd1-gtpose.txt") +
-         " --gt-source " + demo("demo-pcd2-gtpose.txt");
+  return "match " + demo("demo-pcd1.pcd") + " " + demo("demo-pcd2.pcd") + " --gt-target " +
+         demo("demo-pcd1-gtpose.txt") + " --gt-source " + demo("demo-pcd2-gtpose.txt");
 }
 
 size_t lines(const std::string& s) { return static_cast<size_t>(std::count(s.begin(), s.end(), '\n')); }
@@ -122,7 +122,8 @@ TEST(Cli, NoReliableMatchExitsOneWithoutTransform) {
     out << 6 * next() << " " << 6 * next() << " " << 3 * next() << "\n";
   }
   out.close();
-  const auto r = runTomomap("match " + demo("demo-pcd1.pcd") + " " + (dir / "noise.xyz") + " --json " + (dir / "r.json"));
+  const auto r =
+      runTomomap("match " + demo("demo-pcd1.pcd") + " " + (dir / "noise.xyz") + " --json " + (dir / "r.json"));
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("no reliable match"), std::string::npos);
   EXPECT_EQ(r.output.find("T_target_source"), std::string::npos);

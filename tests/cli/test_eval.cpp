@@ -27,7 +27,8 @@ TEST(Eval, SuiteErrorsNameFileLineAndProblem) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("syntax.toml:2:"), std::string::npos) << r.output;
 
-  std::ofstream(dir / "method.toml") << "name = \"x\"\nmethods = [\"tomomap\", \"icp\"]\n[[synth]]\nworld = \"indoor\"\n";
+  std::ofstream(dir / "method.toml")
+      << "name = \"x\"\nmethods = [\"tomomap\", \"icp\"]\n[[synth]]\nworld = \"indoor\"\n";
   r = runTomomap("eval " + (dir / "method.toml") + " -o " + (dir / "out"));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("method.toml:2:"), std::string::npos) << r.output;
@@ -46,11 +47,11 @@ TEST(Eval, MissingMapIsLeftOutAndTheRestRuns) {
   const std::string d = test::demoRoom() + "/";
   std::ofstream(dir / "s.toml") << "name = \"mixed\"\nmethods = [\"tomomap\"]\n"
                                 << "[[pair]]\nname = \"gone\"\ntarget = \"/nonexistent/a.pcd\"\nsource = \"" << d
-                                << "demo-pcd2.pcd\"\ngt_target = \"" << d << "demo-pcd1-gtpose.txt\"\ngt_source = \"" << d
-                                << "demo-pcd2-gtpose.txt\"\n"
+                                << "demo-pcd2.pcd\"\ngt_target = \"" << d << "demo-pcd1-gtpose.txt\"\ngt_source = \""
+                                << d << "demo-pcd2-gtpose.txt\"\n"
                                 << "[[pair]]\nname = \"room\"\ntarget = \"" << d << "demo-pcd1.pcd\"\nsource = \"" << d
-                                << "demo-pcd2.pcd\"\ngt_target = \"" << d << "demo-pcd1-gtpose.txt\"\ngt_source = \"" << d
-                                << "demo-pcd2-gtpose.txt\"\ngrid = 0.05\n";
+                                << "demo-pcd2.pcd\"\ngt_target = \"" << d << "demo-pcd1-gtpose.txt\"\ngt_source = \""
+                                << d << "demo-pcd2-gtpose.txt\"\ngrid = 0.05\n";
   const auto r = runTomomap("eval " + (dir / "s.toml") + " -o " + (dir / "out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("pair 'gone' left out"), std::string::npos) << r.output;

@@ -26,9 +26,7 @@ AgreedTransform sample() {
   return t;
 }
 
-void expectSame(const AgreedTransform& a, const AgreedTransform& b) {
-  EXPECT_EQ(toJson(a), toJson(b));
-}
+void expectSame(const AgreedTransform& a, const AgreedTransform& b) { EXPECT_EQ(toJson(a), toJson(b)); }
 
 }  // namespace
 

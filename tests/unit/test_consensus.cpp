@@ -8,7 +8,7 @@ TEST(Consensus, PicksTheLargestAgreeingCluster) {
   std::vector<Rigid2D> est;
   for (int i = 0; i < 5; ++i) est.push_back({0.50 + 0.01 * i, {10.0 + 0.02 * i, 5.0}});  // the true cluster
   for (int i = 0; i < 3; ++i) est.push_back({-1.0, {-3.0 + 0.01 * i, 2.0}});             // an aliased one
-  est.push_back({2.0, {40, 40}});                                                         // a stray
+  est.push_back({2.0, {40, 40}});                                                        // a stray
   ConsensusParams p;
   const Consensus c = findConsensus(est, p);
   EXPECT_EQ(c.support(), 5u);

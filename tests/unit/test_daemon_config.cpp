@@ -52,10 +52,14 @@ TEST(DaemonConfig, ErrorsNameFileLineAndKey) {
   e = errorOf(dir, "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\ncolour = 3\n");
   EXPECT_NE(e.find("c.toml:4:"), std::string::npos) << e;
   EXPECT_NE(e.find("unknown key"), std::string::npos) << e;
-  e = errorOf(dir, "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n[[peer]]\nid = \"b\"\nhost = \"nowhere\"\nport = 1\n");
+  e = errorOf(dir,
+              "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n[[peer]]\nid = \"b\"\nhost = "
+              "\"nowhere\"\nport = 1\n");
   EXPECT_NE(e.find("c.toml:6:"), std::string::npos) << e;
   EXPECT_NE(e.find("IPv4"), std::string::npos) << e;
-  e = errorOf(dir, "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n[[peer]]\nid = \"alpha\"\nhost = \"1.2.3.4\"\nport = 17600\n");
+  e = errorOf(dir,
+              "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n[[peer]]\nid = \"alpha\"\nhost = "
+              "\"1.2.3.4\"\nport = 17600\n");
   EXPECT_NE(e.find("own id"), std::string::npos) << e;
   e = errorOf(dir, "agent = \"alpha\"\nmap = [1\n");
   EXPECT_NE(e.find("c.toml:2:"), std::string::npos) << e;

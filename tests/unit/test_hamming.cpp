@@ -30,8 +30,7 @@ TEST(Hamming, MutualNearestMatchesBruteForce) {
   }
   const auto got = mutualNearest(a, b);
   EXPECT_EQ(got, expected);
-  for (int i = 0; i < 100; ++i)
-    EXPECT_NE(std::find(got.begin(), got.end(), std::make_pair(i, i + 50)), got.end());
+  for (int i = 0; i < 100; ++i) EXPECT_NE(std::find(got.begin(), got.end(), std::make_pair(i, i + 50)), got.end());
 }
 
 TEST(Hamming, EmptySetsGiveNoMatches) {

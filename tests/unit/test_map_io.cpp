@@ -10,7 +10,8 @@ using tomomap::test::TempDir;
 
 static Points grid(int n) {
   Points p;
-  for (int i = 0; i < n; ++i) p.emplace_back(0.1f * static_cast<float>(i % 20), 0.1f * static_cast<float>(i / 20), 0.01f * static_cast<float>(i));
+  for (int i = 0; i < n; ++i)
+    p.emplace_back(0.1f * static_cast<float>(i % 20), 0.1f * static_cast<float>(i / 20), 0.01f * static_cast<float>(i));
   return p;
 }
 
@@ -82,7 +83,8 @@ TEST(MapIo, TinyMapIsRejected) {
 TEST(MapIo, NonFinitePointsAreRejected) {
   TempDir dir;
   std::string xyz;
-  for (const auto& q : grid(200)) xyz += std::to_string(q.x()) + " " + std::to_string(q.y()) + " " + std::to_string(q.z()) + "\n";
+  for (const auto& q : grid(200))
+    xyz += std::to_string(q.x()) + " " + std::to_string(q.y()) + " " + std::to_string(q.z()) + "\n";
   write(dir / "nan.xyz", xyz + "nan 1 2\ninf 0 0\n");
   EXPECT_NE(errorOf([&] { loadMap(dir / "nan.xyz"); }).find("2 of 202 points are NaN or infinite"), std::string::npos);
   Points p = grid(200);

@@ -60,7 +60,8 @@ TEST(Matcher, UnrelatedNoiseIsNoReliableMatch) {
 TEST(Matcher, FlatMapIsNoReliableMatch) {
   Points flat;
   for (int i = 0; i < 100; ++i)
-    for (int j = 0; j < 100; ++j) flat.emplace_back(0.05f * static_cast<float>(i), 0.05f * static_cast<float>(j * (1 + (i % 7 == 0))), 0.f);
+    for (int j = 0; j < 100; ++j)
+      flat.emplace_back(0.05f * static_cast<float>(i), 0.05f * static_cast<float>(j * (1 + (i % 7 == 0))), 0.f);
   const MatchResult r = matchMaps(flat, flat, MatchParams{});
   EXPECT_FALSE(r.reliable);
   EXPECT_NE(r.reason.find("too few descriptive slices"), std::string::npos);

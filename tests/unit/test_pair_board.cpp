@@ -137,6 +137,22 @@ TEST(PairBoard, AClaimerThatDisappearsIsTakenOver) {
   EXPECT_EQ(other.step(t0 + 1s).claims.size(), 1u);
 }
 
+TEST(PairBoard, ALongComputationRenewsItsClaimSoNobodyTakesOver) {
+  PairBoard alpha = holdingBoth("alpha"), bravo = holdingBoth("bravo");
+  const PairAt claim = alpha.step(t0).claims.at(0);
+  bravo.claimSeen("alpha", claim, t0);
+  ASSERT_TRUE(alpha.step(t0 + 500ms).compute);
+  // alpha matches for 30 s, far past the 8 s claim timeout, and renews its
+  // claim every 2 s; bravo hears each renewal and never claims the pair.
+  for (auto t = t0 + 1s; t < t0 + 30s; t += 1s) {
+    for (const PairAt& renewed : alpha.step(t).claims) {
+      EXPECT_EQ(renewed.pair, kAB);
+      bravo.claimSeen("alpha", renewed, t);
+    }
+    EXPECT_TRUE(bravo.step(t).claims.empty()) << "at " << std::chrono::duration<double>(t - t0).count() << " s";
+  }
+}
+
 TEST(PairBoard, AClaimForOtherVersionsIsNoClaim) {
   PairBoard bravo = holdingBoth("bravo");
   bravo.claimSeen("alpha", {kAB, 1, 99}, t0);  // alpha holds another version of bravo's map

@@ -14,8 +14,10 @@ static Correspondences withOutliers(const Rigid2D& truth, size_t n, double outli
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d s(u(rng), u(rng));
     c.source.push_back(s);
-    if (i < static_cast<size_t>(outlier_ratio * static_cast<double>(n))) c.target.emplace_back(u(rng), u(rng));
-    else c.target.push_back(truth.apply(s) + Eigen::Vector2d(noise(rng), noise(rng)));
+    if (i < static_cast<size_t>(outlier_ratio * static_cast<double>(n)))
+      c.target.emplace_back(u(rng), u(rng));
+    else
+      c.target.push_back(truth.apply(s) + Eigen::Vector2d(noise(rng), noise(rng)));
   }
   return c;
 }

@@ -7,8 +7,8 @@
 #include "core/matcher.hpp"
 #include "support.hpp"
 #include "synth/synth.hpp"
-#include "transport/participant.hpp"
 #include "transport/map_offer.hpp"
+#include "transport/participant.hpp"
 #include "transport/reassembler.hpp"
 #include "transport/wire_sizes.hpp"
 

@@ -28,7 +28,7 @@ TEST(Slices, BoundaryBelongsToTheLowerSlice) {
   SliceGrid g;
   g.cell = 0.5;  // exactly representable, so the boundary is exact
   g.z_min = 0.0;
-  EXPECT_EQ(g.sliceIndex(0.25), 0);  // h_0 + g/2 is in slice 0 ...
+  EXPECT_EQ(g.sliceIndex(0.25), 0);       // h_0 + g/2 is in slice 0 ...
   EXPECT_EQ(g.sliceIndex(0.2500001), 1);  // ... and just above it is slice 1
   EXPECT_EQ(g.sliceIndex(-0.25), -1);
 }
