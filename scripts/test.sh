@@ -13,7 +13,7 @@ scripts/build.sh
 (cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j"$jobs" --timeout 1200 -LE large)
 
 echo "== sanitizer build (ASan + UBSan): unit and daemon tests"
-BUILD_DIR=build-asan BUILD_TYPE=RelWithDebInfo TARGETS="unit_tests daemon_tests tomomapd tomomap" \
+BUILD_DIR=build-asan TARGETS="unit_tests daemon_tests tomomapd tomomap" \
   scripts/build.sh -DTOMOMAP_SANITIZE=ON
 export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

@@ -179,7 +179,10 @@ struct EvalOptions {
 
 int runEval(const EvalOptions& o) {
   Suite suite = loadSuite(o.suite);
-  if (!o.methods.empty()) suite.methods = o.methods;
+  if (!o.methods.empty()) {
+    suite.methods = o.methods;
+    for (auto& y : suite.synth) y.methods.clear();  // the command line decides for every pair
+  }
   for (const auto& w : suite.warnings) std::cerr << "tomomap eval: warning: " << w << "\n";
   const fs::path out(o.out);
   std::error_code ec;
@@ -199,16 +202,18 @@ int runEval(const EvalOptions& o) {
         std::cerr << "generating " << name << "\n";
         const GeneratedWorld w = writeSynthWorld(sp, synth::noiseLevel(noise), (out / "worlds" / name).string());
         suite.pairs.push_back(
-            {name, w.maps[0], w.maps[1], w.poses[0], w.poses[1], y.grid > 0 ? y.grid : w.grid, noise});
+            {name, w.maps[0], w.maps[1], w.poses[0], w.poses[1], y.grid > 0 ? y.grid : w.grid, noise, y.methods});
       }
 
   std::ofstream rows_csv(out / "rows.csv");
   std::ofstream rows_json(out / "rows.jsonl");
   rows_csv << kCsvHeader << "\n";
   std::vector<Row> rows;
-  const size_t total = suite.pairs.size() * suite.methods.size();
+  auto methodsOf = [&](const SuitePair& p) { return p.methods.empty() ? suite.methods : p.methods; };
+  size_t total = 0;
+  for (const auto& p : suite.pairs) total += methodsOf(p).size();
   for (const auto& p : suite.pairs)
-    for (const auto& m : suite.methods) {
+    for (const auto& m : methodsOf(p)) {
       Row r = runOne(p, m, out, o.threads);
       rows.push_back(r);
       // Written as they finish: an interrupted run keeps every finished row.

@@ -1,5 +1,7 @@
 #include "suite.hpp"
 
+#include <algorithm>
+
 #include <toml++/toml.h>
 
 #include <filesystem>
@@ -110,7 +112,7 @@ Suite loadSuite(const std::string& path) {
     for (const auto& e : *a) {
       const toml::table* t = e.as_table();
       if (!t) fail(path, e.source(), "each [[synth]] must be a table");
-      checkKeys(path, *t, {"world", "seeds", "noise", "scale", "grid"}, "[[synth]]");
+      checkKeys(path, *t, {"world", "seeds", "noise", "scale", "grid", "methods"}, "[[synth]]");
       SuiteSynth y;
       y.world = text(path, *t, "world", "[[synth]]");
       if (y.world != "indoor" && y.world != "outdoor")
@@ -122,6 +124,10 @@ Suite loadSuite(const std::string& path) {
           fail(path, t->get("noise")->source(), "unknown noise level '" + n + "'");
       y.scale = number(path, *t, "scale", 1.0);
       y.grid = number(path, *t, "grid", 0.0);
+      y.methods = list<std::string>(path, *t, "methods", y.methods);
+      for (const auto& m : y.methods)
+        if (std::find(s.methods.begin(), s.methods.end(), m) == s.methods.end())
+          fail(path, t->get("methods")->source(), "method '" + m + "' is not one of the suite's methods");
       s.synth.push_back(y);
     }
   }

@@ -13,6 +13,7 @@ struct SuitePair {
   std::string target, source, gt_target, gt_source;  ///< paths (resolved against the suite's folder)
   double grid = MatchParams{}.grid;                  ///< [m]
   std::string noise = "real";                        ///< noise label for grouping: real data, or the synth level
+  std::vector<std::string> methods;                  ///< methods for this pair; empty: the suite's
 };
 
 /// Generated pairs: every seed x noise level of one world type.
@@ -22,6 +23,7 @@ struct SuiteSynth {
   std::vector<std::string> noise{"low"};
   double scale = 1.0;
   double grid = 0;  ///< grid size to match at [m]; 0 = the world's own
+  std::vector<std::string> methods;  ///< methods for these pairs (a subset of the suite's); empty: the suite's
 };
 
 struct Suite {

@@ -62,20 +62,31 @@ TEST(Eval, MissingMapIsLeftOutAndTheRestRuns) {
 }
 
 // The CI suite shipped with the project: both world types, three noise levels,
-// tomomap next to the FPFH-RANSAC baseline. Asserts tomomap's success rate;
-// timings are reported, never asserted.
-TEST(Eval, QuickSuiteSucceedsAndDrawsBoxPlots) {
+// tomomap on every pair, the FPFH-RANSAC baseline beside it where the noise is
+// high. Asserts tomomap's success rate; timings are reported, never asserted.
+TEST(Eval, CiSuiteSucceedsAndDrawsBoxPlots) {
   TempDir dir;
-  const auto r = runTomomap("eval " + std::string(TOMOMAP_SOURCE_DIR) + "/tests/suites/quick.toml -o " + (dir / "out"));
+  const auto r = runTomomap("eval " + std::string(TOMOMAP_SOURCE_DIR) + "/tests/suites/ci.toml -o " + (dir / "out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::cout << r.output;
   for (const char* noise : {"none", "low", "high"})
     EXPECT_NE(r.output.find(std::string("| tomomap | ") + noise + " | 2 | 2/2 |"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("| fpfh-ransac | high | 2 |"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("| fpfh-ransac | low |"), std::string::npos) << "the baseline runs where the suite says";
   EXPECT_NE(r.output.find("fpfh-ransac / tomomap: median time"), std::string::npos) << r.output;
   const std::string rows = slurp(dir / "out/rows.csv");
-  EXPECT_EQ(std::count(rows.begin(), rows.end(), '\n'), 1 + 12) << rows;
+  EXPECT_EQ(std::count(rows.begin(), rows.end(), '\n'), 1 + 6 + 2) << rows;
   const cv::Mat plots = cv::imread(dir / "out/boxplots.png");
   ASSERT_FALSE(plots.empty());
   EXPECT_GT(plots.cols, 1000);
+}
+
+TEST(Eval, ASynthBlockMayNameOnlyTheSuitesMethods) {
+  TempDir dir;
+  std::ofstream(dir / "s.toml") << "name = \"x\"\nmethods = [\"tomomap\"]\n[[synth]]\nworld = \"indoor\"\n"
+                                << "methods = [\"fpfh-ransac\"]\n";
+  const auto r = runTomomap("eval " + (dir / "s.toml") + " -o " + (dir / "out"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("s.toml:5:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("not one of the suite's methods"), std::string::npos) << r.output;
 }

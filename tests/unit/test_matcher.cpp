@@ -78,3 +78,27 @@ TEST(Matcher, BadInputThrows) {
   b.grid = 0.1;
   EXPECT_THROW(matchFeatures(a, b, MatchParams{}), InputError);
 }
+
+TEST(Matcher, TheSlicePairTableKeepsExactlyTheMatchesOfEachPair) {
+  // Refinement reuses the table's matches instead of matching again: they must
+  // be the very matches a fresh brute-force match of the pair gives.
+  REQUIRE_DEMO_ROOM();
+  const auto demo = test::loadDemoPair();
+  const MatchParams p;
+  const MapFeatures t = describeMap(demo.map1, p), s = describeMap(demo.map2, p);
+  const SlicePairTable table = estimateSlicePairs(t, s, p, {});
+  ASSERT_EQ(table.estimates.size(), t.slices.size() * s.slices.size());
+  size_t with_estimate = 0;
+  for (size_t a = 0; a < t.slices.size(); a += 7)
+    for (size_t b = 0; b < s.slices.size(); b += 5) {
+      const Correspondences kept = correspondencesOf(table, t, s, a, b);
+      const Correspondences fresh = matchSlices(t.slices[a], s.slices[b]);
+      ASSERT_EQ(kept.size(), fresh.size());
+      for (size_t i = 0; i < kept.size(); ++i) {
+        EXPECT_EQ(kept.source[i], fresh.source[i]);
+        EXPECT_EQ(kept.target[i], fresh.target[i]);
+      }
+      with_estimate += table.estimates[table.index(a, b)].ok;
+    }
+  EXPECT_GT(with_estimate, 0u);
+}

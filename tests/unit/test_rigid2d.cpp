@@ -75,3 +75,37 @@ TEST(Rigid2D, SameSeedSameResult) {
   EXPECT_EQ(a->transform.yaw, b->transform.yaw);
   EXPECT_EQ(a->inliers, b->inliers);
 }
+
+TEST(Rigid2D, ClosedFormFitHoldsAtEveryYawAndWithASubset) {
+  for (double yaw : {-3.14159, -1.5, 0.0, 1e-7, 2.0, 3.14159}) {
+    const Rigid2D truth{yaw, {-40, 25}};
+    Correspondences c = withOutliers(truth, 30, 0.0, 3);
+    for (size_t i = 0; i < c.size(); ++i) c.target[i] = truth.apply(c.source[i]);
+    c.source.emplace_back(1000, 1000);  // not in the subset: must not count
+    c.target.emplace_back(-1000, 0);
+    std::vector<uint32_t> subset(30);
+    for (uint32_t i = 0; i < 30; ++i) subset[i] = i;
+    const Rigid2D fit = fitRigid2D(c, &subset);
+    EXPECT_NEAR(wrapAngle(fit.yaw - yaw), 0, 1e-9) << yaw;
+    EXPECT_NEAR((fit.t - truth.t).norm(), 0, 1e-7) << yaw;
+  }
+}
+
+TEST(Rigid2D, RefinementStopsAsItsRuleSays) {
+  const Rigid2D truth{0.3, {1, 2}};
+  const Correspondences c = withOutliers(truth, 200, 0.3, 5);
+  // A start a little off, with every correspondence as inlier.
+  std::vector<uint32_t> all(c.size());
+  for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+  const RigidEstimate start{{0.31, {1.05, 1.95}}, all};
+  // The inlier set must shrink to the true inliers: refused without allow_shrinking.
+  const RigidEstimate kept = refineLeastSquares(c, start, 0.1, {5, false});
+  EXPECT_EQ(kept.inliers.size(), c.size()) << "no round may lose inliers: the start stays";
+  // From the inliers of a near start, it converges onto the truth.
+  const Rigid2D near{0.305, {1.03, 1.98}};
+  const RigidEstimate fine = refineLeastSquares(c, {near, collectInliers(c, near, 0.3)}, 0.3, {10, true});
+  EXPECT_NEAR(wrapAngle(fine.transform.yaw - 0.3), 0, 0.002);
+  EXPECT_LT((fine.transform.t - truth.t).norm(), 0.02);
+  EXPECT_GE(fine.inliers.size(), 130u);
+  EXPECT_EQ(fine.inliers, collectInliers(c, fine.transform, 0.3)) << "inliers are those of the result";
+}
