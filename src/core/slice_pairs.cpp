@@ -17,8 +17,8 @@ Correspondences positions(const SliceFeatures& target, const SliceFeatures& sour
   c.source.reserve(matches.size());
   c.target.reserve(matches.size());
   for (const auto& [s, t] : matches) {
-    c.source.push_back(source.keypoints[static_cast<size_t>(s)].cast<double>());
-    c.target.push_back(target.keypoints[static_cast<size_t>(t)].cast<double>());
+    c.source.emplace_back(source.keypoints[static_cast<size_t>(s)].cast<double>());
+    c.target.emplace_back(target.keypoints[static_cast<size_t>(t)].cast<double>());
   }
   return c;
 }
