@@ -1,6 +1,7 @@
 #include "participant.hpp"
 
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/test_UDPv4TransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
 #include <algorithm>
@@ -50,7 +51,16 @@ DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipant
   DomainParticipantQos q;
   q.name("tomomapd/" + c.agent);
   q.transport().use_builtin_transports = false;
-  auto transport = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  std::shared_ptr<eprosima::fastdds::rtps::SocketTransportDescriptor> transport;
+  if (c.test_drop_percent > 0) {
+    // Test only: Fast DDS's own lossy UDPv4 transport drops this share of every
+    // RTPS message this participant sends (the kernel here has no netem).
+    auto lossy = std::make_shared<eprosima::fastdds::rtps::test_UDPv4TransportDescriptor>();
+    lossy->percentageOfMessagesToDrop = static_cast<uint8_t>(c.test_drop_percent);
+    transport = lossy;
+  } else {
+    transport = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  }
   transport->sendBufferSize = 1 << 20;
   transport->receiveBufferSize = 1 << 20;
   q.transport().user_transports.push_back(transport);

@@ -27,6 +27,7 @@ struct TransportConfig {
   uint16_t data_port = 0;
   std::vector<PeerAddress> peers;
   double bandwidth_kbps = 10000;  ///< budget for slice data [kbit/s]
+  int test_drop_percent = 0;      ///< test only: share of sent RTPS messages dropped [%]
 };
 
 /// Flow-controller period [ms]: the budget is enforced per period.
