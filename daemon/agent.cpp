@@ -9,7 +9,7 @@ namespace tomomap::daemon {
 Agent::Agent(Config config, Log& log)
     : config_(std::move(config)),
       log_(log),
-      sender_(config_.transport.bandwidth_kbps, fromSeconds(config_.request_interval_s)),
+      sender_(transport::streamKbps(config_.transport), fromSeconds(config_.request_interval_s)),
       peers_(config_.agent(), log),
       board_(config_.agent(), boardTimings(config_)),
       worker_([this] { queue_cv_.notify_one(); }) {}

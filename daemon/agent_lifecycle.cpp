@@ -90,7 +90,7 @@ void Agent::reload() {
   config_ = std::move(next);
   log_.setThreshold(config_.log_level);
   log_.info(describe(config_));
-  sender_.setBudget(config_.transport.bandwidth_kbps, fromSeconds(config_.request_interval_s));
+  sender_.setBudget(transport::streamKbps(config_.transport), fromSeconds(config_.request_interval_s));
   board_.setTimings(boardTimings(config_));
   if (!sameNetwork(previous.transport, config_.transport)) {
     log_.info("network settings changed: leaving and joining again");

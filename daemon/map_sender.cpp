@@ -4,10 +4,10 @@
 
 namespace tomomap::daemon {
 
-MapSender::MapSender(double bandwidth_kbps, Clock::duration grace) : kbps_(bandwidth_kbps), grace_(grace) {}
+MapSender::MapSender(double stream_kbps, Clock::duration grace) : kbps_(stream_kbps), grace_(grace) {}
 
-void MapSender::setBudget(double bandwidth_kbps, Clock::duration grace) {
-  kbps_ = bandwidth_kbps;
+void MapSender::setBudget(double stream_kbps, Clock::duration grace) {
+  kbps_ = stream_kbps;
   grace_ = grace;
 }
 

@@ -16,10 +16,11 @@ namespace tomomap::daemon {
 
 class MapSender {
  public:
-  /// `bandwidth_kbps`: the flow controller's budget; `grace`: how long after a
-  /// slice's expected departure a request for it is still taken as crossed.
-  MapSender(double bandwidth_kbps, Clock::duration grace);
-  void setBudget(double bandwidth_kbps, Clock::duration grace);
+  /// `stream_kbps`: the rate the flow controller lets each written byte leave
+  /// at (transport::streamKbps); `grace`: how long after a slice's expected
+  /// departure a request for it is still taken as crossed.
+  MapSender(double stream_kbps, Clock::duration grace);
+  void setBudget(double stream_kbps, Clock::duration grace);
 
   /// A new map to offer: what was queued belongs to the old version and is
   /// dropped (peers ask again for what they need).

@@ -7,6 +7,7 @@ namespace tomomap::daemon {
 namespace {
 
 constexpr size_t kTransfersKept = 8;
+constexpr int kMaxBackoffDoublings = 4;  ///< requests back off to 16 x request_interval_s at most
 
 }  // namespace
 
@@ -57,6 +58,7 @@ PeerMaps::Received PeerMaps::receive(const wire::SliceFeatures& s, size_t bytes,
   if (out.first) p.first_slice = now;
   p.bytes += bytes;
   p.last_slice = p.last_progress = now;
+  p.unanswered = 0;
   if (p.incoming->complete()) {
     complete(it->first, p);
     out.completed = true;
@@ -81,9 +83,10 @@ std::vector<wire::ChunkRequest> PeerMaps::due(Clock::duration interval, bool at_
   for (auto& [id, p] : peers_) {
     if (!p.incoming || p.features) continue;
     const auto quiet_since = std::max(p.last_progress, p.last_request);
-    if (!at_once && now - quiet_since < interval) continue;
+    if (!at_once && now - quiet_since < interval * (1 << std::min(p.unanswered, kMaxBackoffDoublings))) continue;
     out.push_back(requestFor(id, p, /*everything=*/false));
     p.last_request = now;
+    ++p.unanswered;
     log_.info("asked " + id + " again for " + std::to_string(out.back().slices().size()) + " missing slices");
   }
   return out;

@@ -40,7 +40,10 @@ class PeerMaps {
   Received receive(const wire::SliceFeatures& s, size_t bytes, Clock::time_point now);
 
   /// Requests for the maps still incomplete that have made no progress for
-  /// `interval` (all of them when `at_once`).
+  /// `interval` (all of them when `at_once`). Each request without progress
+  /// since doubles the wait before the next (up to 16 x): on a thin link a
+  /// transfer that is merely slow must not be asked for again and again,
+  /// since every resend reaches every receiver.
   std::vector<wire::ChunkRequest> due(Clock::duration interval, bool at_once, Clock::time_point now);
 
   std::shared_ptr<const MapFeatures> features(const std::string& peer) const;
@@ -76,6 +79,7 @@ class PeerMaps {
     Clock::time_point first_slice{}, last_slice{};
     size_t bytes = 0, samples = 0;
     size_t reused = 0;  ///< slices kept from the previous version
+    int unanswered = 0; ///< requests since the last progress
   };
   /// A finished transfer of one version of a peer's map.
   struct Transfer {

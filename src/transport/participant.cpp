@@ -24,6 +24,14 @@ size_t bytesPerPeriod(double kbps) {
   return static_cast<size_t>(std::max(1.0, kbps * 1000.0 / 8.0 * kFlowPeriodMs / 1000.0));
 }
 
+double streamKbps(const TransportConfig& c) {
+  return (1 - kControlShare) * c.bandwidth_kbps / static_cast<double>(std::max<size_t>(1, c.peers.size()));
+}
+
+int flowPeriodMs(const TransportConfig& c) {
+  return kFlowPeriodMs * static_cast<int>(std::max<size_t>(1, c.peers.size()));
+}
+
 size_t maxSampleBytes(double kbps) {
   // The controller sends whole samples only and a sample that does not fit the
   // rest of a period waits for the next one. Slices vary in size, so with
@@ -76,8 +84,10 @@ DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipant
   auto flow = std::make_shared<eprosima::fastdds::rtps::FlowControllerDescriptor>();
   flow->name = kFlowControllerName;
   flow->scheduler = eprosima::fastdds::rtps::FlowControllerSchedulerPolicy::FIFO;
-  flow->max_bytes_per_period = static_cast<int32_t>(bytesPerPeriod(c.bandwidth_kbps));
-  flow->period_ms = kFlowPeriodMs;
+  // Per stretched period, the stream's share for every receiver: each byte
+  // written leaves once per receiver, so the egress stays within the budget.
+  flow->max_bytes_per_period = static_cast<int32_t>(bytesPerPeriod((1 - kControlShare) * c.bandwidth_kbps));
+  flow->period_ms = static_cast<uint64_t>(flowPeriodMs(c));
   q.flow_controllers().push_back(flow);
 
   DomainParticipant* p = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(c.domain),

@@ -30,8 +30,25 @@ struct TransportConfig {
   int test_drop_percent = 0;      ///< test only: share of sent RTPS messages dropped [%]
 };
 
-/// Flow-controller period [ms]: the budget is enforced per period.
+/// Flow-controller period [ms] with one receiver: the budget is enforced per period.
 constexpr int kFlowPeriodMs = 100;
+
+/// Share of the budget left to control traffic (discovery, heartbeats,
+/// acknowledgements, requests, claims, estimates), which does not pass the
+/// flow controller: the slice data gets the rest.
+constexpr double kControlShare = 0.1;
+
+/// The budget is total egress, and every slice sample goes to every receiver
+/// (one unicast datagram each), so the slice stream itself may use
+/// (1 - kControlShare) / receivers of it [kbit/s]. Receivers are the
+/// configured peers (at least one).
+double streamKbps(const TransportConfig& c);
+
+/// The flow controller's period [ms]: bytesPerPeriod(bandwidth_kbps) leave per
+/// period as samples, each reaching every receiver, so the period stretches
+/// with the receivers instead of the bytes per period shrinking (a sample must
+/// fit one period's bytes, and the sample size must not depend on the fleet).
+int flowPeriodMs(const TransportConfig& c);
 /// The flow controller's name (a static string: Fast DDS keeps the pointer).
 extern const char* const kFlowControllerName;
 

@@ -127,6 +127,8 @@ def main():
     p.add_argument("--timeout", type=float, default=600)
     p.add_argument("--prefix", default="tmlink")
     p.add_argument("--json", help="write the report here")
+    p.add_argument("--max-wire-ratio", type=float, help="fail if an agent's wire bytes exceed this x payload x receivers")
+    p.add_argument("--max-peak-ratio", type=float, help="fail if an agent's peak 5 s egress exceeds this x budget")
     p.add_argument("--keep", help="keep configs, logs and state in this folder")
     args = p.parse_args()
     if os.geteuid() != 0:
@@ -210,7 +212,17 @@ def main():
     if args.json:
         with open(args.json, "w") as f:
             json.dump(report, f, indent=2)
-    return 0 if t is not None else 1
+    failures = [] if t is not None else ["no agreement within the timeout"]
+    for a, r in report["per_agent"].items():
+        if args.max_wire_ratio and r["wire_per_payload_per_receiver"] > args.max_wire_ratio:
+            failures.append(f"{a}: {r['wire_per_payload_per_receiver']:.2f} x payload x receivers on the wire "
+                            f"(bound {args.max_wire_ratio})")
+        if args.max_peak_ratio and r["peak_5s_kbit"] > args.max_peak_ratio * args.budget_kbps:
+            failures.append(f"{a}: peak {r['peak_5s_kbit']:.0f} kbit/s over {WINDOW_S} s "
+                            f"(bound {args.max_peak_ratio} x {args.budget_kbps})")
+    for f in failures:
+        print("FAILED: " + f)
+    return 1 if failures else 0
 
 
 if __name__ == "__main__":
