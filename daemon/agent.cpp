@@ -169,7 +169,8 @@ void Agent::requestMissing(bool at_once) {
 }
 
 void Agent::claimAndCompute() {
-  if (!worker_.idle()) return;
+  // The board knows when a match is running: then it only renews that claim.
+  const bool renewing = board_.computing().has_value();
   const BoardStep step = board_.step(Clock::now());
   for (const PairAt& at : step.claims) {
     wire::MatchClaim c;
@@ -180,7 +181,10 @@ void Agent::claimAndCompute() {
     c.claimer(config_.agent());
     c.claimed_at_ms(wallMs());
     bus_->publish(c);
-    log_.info("claimed " + pairText(at.pair));
+    if (renewing)
+      log_.debug("renewed the claim on " + pairText(at.pair));
+    else
+      log_.info("claimed " + pairText(at.pair));
   }
   for (const auto& y : step.yielded) log_.info("yielding " + y);
   if (!step.compute) return;

@@ -43,12 +43,16 @@ class Fleet {
 
   uint16_t port(size_t index) const { return static_cast<uint16_t>(base_port_ + 4 * index); }
 
+  /// Written into every config: a claim without a result or renewal is void after this [s].
+  double claim_timeout_s = 8;
+
   /// Writes the config of `spec`; `everyone` lists the fleet (for ports).
   std::string writeConfig(const AgentSpec& spec, const std::vector<AgentSpec>& everyone) {
     std::ostringstream c;
     c << "agent = \"" << spec.id << "\"\nmap = \"" << spec.map << "\"\ngrid = " << spec.grid
       << "\ndiscovery_port = " << port(indexOf(spec.id, everyone)) << "\nbandwidth_kbps = " << spec.bandwidth_kbps
-      << "\noutput_dir = \"" << (dir_ / ("out-" + spec.id)) << "\"\nrequest_interval_s = 1\nclaim_timeout_s = 8\n";
+      << "\noutput_dir = \"" << (dir_ / ("out-" + spec.id)) << "\"\nrequest_interval_s = 1\nclaim_timeout_s = " << claim_timeout_s
+      << "\n";
     for (const auto& other : everyone) {
       if (other.id == spec.id) continue;
       if (!spec.peers.empty() && std::find(spec.peers.begin(), spec.peers.end(), other.id) == spec.peers.end())

@@ -16,6 +16,7 @@ import argparse
 import json
 import os
 import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -200,6 +201,8 @@ def main():
             except subprocess.TimeoutExpired:
                 proc.kill()
         bed.down()
+        if not args.keep:
+            shutil.rmtree(work, ignore_errors=True)
 
     t = report["seconds_to_agreement"]
     print(f"{n} agents, tbf {args.rate_kbit} kbit/s, budget {args.budget_kbps} kbit/s, {args.loss} % loss: "
