@@ -45,6 +45,9 @@ size_t maxSampleBytes(double kbps) {
 
 namespace {
 
+constexpr size_t kMtuPayload = 1472;  ///< UDP payload of a 1500-byte Ethernet frame
+constexpr size_t kRtpsOverhead = 200; ///< RTPS header and DATA submessage around one sample
+
 Locator_t udp(const std::string& host, uint16_t port) {
   Locator_t l;
   l.kind = LOCATOR_KIND_UDPv4;
@@ -71,6 +74,12 @@ DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipant
   }
   transport->sendBufferSize = 1 << 20;
   transport->receiveBufferSize = 1 << 20;
+  // RTPS packs several samples into one datagram up to this size (64 kB by
+  // default), which IP then cuts into MTU-sized fragments: on a lossy link one
+  // lost fragment loses every sample in the datagram. One sample per datagram,
+  // and no datagram above an Ethernet MTU where the samples are that small.
+  transport->maxMessageSize =
+      static_cast<uint32_t>(std::max<size_t>(kMtuPayload, maxSampleBytes(c.bandwidth_kbps) + kRtpsOverhead));
   q.transport().user_transports.push_back(transport);
 
   auto& builtin = q.wire_protocol().builtin;
