@@ -71,9 +71,6 @@ TEST(Daemons, ThreeAgreeOnASynthWorldWithALateJoiner) {
   const auto gen = runTomomap("synth -o " + (dir / "world") + " -n 3 --noise low -s 4 --scale 0.5");
   ASSERT_EQ(gen.exit_code, 0) << gen.output;
   Fleet fleet(dir);
-  // Shorter than a match of these maps takes on a busy machine: the computing
-  // agent must renew its claim, or another takes the pair over and the count fails.
-  fleet.claim_timeout_s = 2;
   std::vector<AgentSpec> agents;
   for (const char* id : {"alpha", "bravo", "charlie"})
     agents.push_back({id, dir / ("world/map_" + std::to_string(agents.size()) + ".pcd")});
