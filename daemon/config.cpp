@@ -110,18 +110,17 @@ void readMatch(const Reader& r, const toml::table& root, MatchParams& m) {
   for (const auto& [key, value] : *t)
     if (std::find(kKeys.begin(), kKeys.end(), "match." + std::string(key.str())) == kKeys.end())
       r.fail(value, "match." + std::string(key.str()), "unknown key (see docs/configuration.md)");
-  const Reader in{r.file};
-  m.features.max_features = in.integer(*t, "max_features", m.features.max_features, 1, 10000);
-  m.features.fast_threshold = in.integer(*t, "fast_threshold", m.features.fast_threshold, 1, 255);
-  m.ransac_threshold_cells = in.number(*t, "ransac_threshold_cells", m.ransac_threshold_cells, 0.5, 50);
-  m.ransac_iterations = in.integer(*t, "ransac_iterations", m.ransac_iterations, 10, 100000);
-  m.ransac_confidence = in.number(*t, "ransac_confidence", m.ransac_confidence, 0.5, 0.999999);
-  m.min_matches = in.integer(*t, "min_matches", m.min_matches, 2, 1000);
-  m.consensus_translation_cells = in.number(*t, "consensus_translation_cells", m.consensus_translation_cells, 0.5, 100);
-  m.consensus_yaw = radians(in.number(*t, "consensus_yaw_deg", degrees(m.consensus_yaw), 0.1, 90));
-  m.min_support = in.integer(*t, "min_support", m.min_support, 1, 1000);
-  m.min_inliers = in.integer(*t, "min_inliers", m.min_inliers, 2, 100000);
-  m.threads = in.integer(*t, "threads", m.threads, 0, 256);
+  m.features.max_features = r.integer(*t, "max_features", m.features.max_features, 1, 10000);
+  m.features.fast_threshold = r.integer(*t, "fast_threshold", m.features.fast_threshold, 1, 255);
+  m.ransac_threshold_cells = r.number(*t, "ransac_threshold_cells", m.ransac_threshold_cells, 0.5, 50);
+  m.ransac_iterations = r.integer(*t, "ransac_iterations", m.ransac_iterations, 10, 100000);
+  m.ransac_confidence = r.number(*t, "ransac_confidence", m.ransac_confidence, 0.5, 0.999999);
+  m.min_matches = r.integer(*t, "min_matches", m.min_matches, 2, 1000);
+  m.consensus_translation_cells = r.number(*t, "consensus_translation_cells", m.consensus_translation_cells, 0.5, 100);
+  m.consensus_yaw = radians(r.number(*t, "consensus_yaw_deg", degrees(m.consensus_yaw), 0.1, 90));
+  m.min_support = r.integer(*t, "min_support", m.min_support, 1, 1000);
+  m.min_inliers = r.integer(*t, "min_inliers", m.min_inliers, 2, 100000);
+  m.threads = r.integer(*t, "threads", m.threads, 0, 256);
 }
 
 std::string checkedAddress(const Reader& r, const toml::table& t, const std::string& key,

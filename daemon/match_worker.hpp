@@ -17,10 +17,9 @@ class MatchWorker {
   explicit MatchWorker(std::function<void()> wake) : wake_(std::move(wake)) {}
   ~MatchWorker();
 
-  /// Starts matching `pair`; only when idle().
+  /// Starts matching `pair`; only when no match runs (the PairBoard starts one at a time).
   void start(const PairAt& pair, std::shared_ptr<const MapFeatures> target, std::shared_ptr<const MapFeatures> source,
              const MatchParams& params, const std::string& me);
-  bool idle() const { return !thread_.joinable(); }
   bool ready() const { return done_; }
   /// The result, once ready(); the worker is idle again afterwards.
   AgreedTransform take();
