@@ -1,13 +1,21 @@
 #pragma once
 // Sending this agent's map: which slices peers asked for, in what order, and
-// when each will have left the flow controller, so that a request for a slice
-// still on its way does not send it again. Pure: the publish call and the
-// time are passed in.
+// when a copy already written will have reached the peer that asks, so that a
+// request for a slice still on its way does not send it again. Pure: the
+// publish call and the time are passed in.
+//
+// What reaches whom (docs/protocol.md): a written sample goes to every reader
+// matched at the time, is repaired by RTPS where lost, and stays in the
+// writer's durable history, from which a reader that matches later gets it,
+// sent to that reader alone. So a request for a slice already written is
+// answered by sending it again only once the copy the requester can still
+// expect is overdue.
 #include <chrono>
 #include <deque>
 #include <functional>
 #include <map>
 #include <set>
+#include <string>
 
 #include "clock.hpp"
 #include "transport/map_offer.hpp"
@@ -17,8 +25,8 @@ namespace tomomap::daemon {
 class MapSender {
  public:
   /// `stream_kbps`: the rate the flow controller lets each written byte leave
-  /// at (transport::streamKbps); `grace`: how long after a slice's expected
-  /// departure a request for it is still taken as crossed.
+  /// at (transport::streamKbps); `grace`: how long after a copy's expected
+  /// arrival a request for it is still taken as crossed.
   MapSender(double stream_kbps, Clock::duration grace);
   void setBudget(double stream_kbps, Clock::duration grace);
 
@@ -28,22 +36,28 @@ class MapSender {
   const transport::MapOffer& offer() const { return offer_; }
   uint64_t version() const { return offer_.announcement.version(); }
 
-  /// A peer asked for `slices` (every announced slice when empty) of `version`.
-  /// Queues those not queued and not still on their way; returns how many of
-  /// them this map has (0 for another version: the announcement tells them).
-  size_t request(uint64_t version, const std::vector<int32_t>& slices, Clock::time_point now);
+  /// Peer `requester` asked for `slices` (every announced slice when empty) of
+  /// `version`. Queues those never written, and those written whose copy is
+  /// overdue at the requester; returns how many of them this map has (0 for
+  /// another version: the announcement tells them).
+  size_t request(const std::string& requester, uint64_t version, const std::vector<int32_t>& slices,
+                 Clock::time_point now);
 
   /// Hands queued parts to `publish` in order until it refuses one (the
-  /// writer's queue is full: the rest goes on a later call). `size` gives a
-  /// sample's bytes on the wire.
+  /// writer is full: the rest goes on a later call). `size` gives a sample's
+  /// bytes on the wire.
   void pump(const std::function<bool(const wire::SliceFeatures&)>& publish,
             const std::function<size_t(const wire::SliceFeatures&)>& size, Clock::time_point now);
 
   size_t queued() const { return queue_.size(); }
   size_t bytesSent() const { return bytes_sent_; }
   size_t samplesSent() const { return samples_sent_; }
+  /// Slices written again because a requester's copy was overdue.
+  size_t resends() const { return resends_; }
 
  private:
+  Clock::duration leaveTime(size_t bytes) const;
+
   double kbps_;
   Clock::duration grace_;
   transport::MapOffer offer_;
@@ -51,10 +65,14 @@ class MapSender {
   std::set<int> queued_;
   size_t next_part_ = 0;  ///< part of queue_.front() to send next
   /// When the flow controller will have sent everything handed to it so far,
-  /// and when each slice's last copy leaves.
+  /// and when each written slice's last copy leaves it.
   Clock::time_point backlog_until_{};
   std::map<int, Clock::time_point> leaves_at_;
-  size_t bytes_sent_ = 0, samples_sent_ = 0;
+  /// Per requester: until when copies already written may still be on their
+  /// way to it (a late reader gets the history after the backlog).
+  std::map<std::string, Clock::time_point> expected_until_;
+  size_t bytes_sent_ = 0, samples_sent_ = 0, resends_ = 0;
+  std::map<int, size_t> slice_bytes_;  ///< bytes of each written slice, as `size` gave them
 };
 
 }  // namespace tomomap::daemon

@@ -82,12 +82,13 @@ DataWriterQos writerQos(const TopicQos& t) {
   return q;
 }
 
-/// Slice samples the writer may hold (sent or not, until acknowledged): about
-/// 4 MiB whatever the sample size. Too few stalled slow links (each ack waits
-/// for a heartbeat); the bound keeps memory flat.
-int historySamples(double kbps) {
-  return static_cast<int>(std::clamp<size_t>((4u << 20) / maxSampleBytes(kbps), 256, 4096));
-}
+/// Slice parts (instances: owner, slice, part) a writer or reader keeps: the
+/// writer one map's worth, the reader every peer's. 65,536 parts are 64 MB of
+/// payload at the smallest sample size, far above any map sent so far.
+constexpr int kSliceInstances = 1 << 16;
+
+constexpr uint32_t kHeartbeatMs = 500;        ///< slice writer's heartbeat period
+constexpr uint32_t kNackSuppressionMs = 500;  ///< longer than a link's round trip plus a queue's wait
 
 }  // namespace
 
@@ -111,10 +112,16 @@ struct Bus::Impl {
     if (flow_controlled) {
       wq.publish_mode().kind = ASYNCHRONOUS_PUBLISH_MODE;
       wq.publish_mode().flow_controller_name = kFlowControllerName;
-      // Sent samples stay in the bounded history until acknowledged, and acks
-      // follow heartbeats (every 3 s by default): on a slow link the history
-      // filled and the writer stalled until the next one. Ask often.
-      wq.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 100000000);
+      // Repairs follow heartbeats (every 3 s by default): ask often, so a lost
+      // sample is sent again within a fraction of a second.
+      wq.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, kHeartbeatMs * 1000000);
+      // A reader repeats its negative acknowledgement with every heartbeat
+      // until the repair arrives; with a link delay and a queue in front of
+      // the repair, each repeat sent the sample again (10 % loss and 50 ms
+      // delay: up to 11 x the map on the wire). Repeats within this time of a
+      // repair's departure are ignored.
+      wq.reliable_writer_qos().times.nackSupressionDuration =
+          eprosima::fastrtps::Duration_t(0, kNackSuppressionMs * 1000000);
     }
     DataWriter* w = publisher->create_datawriter(topic, wq);
     if (!w) throw std::runtime_error("cannot create the writer of " + name);
@@ -137,7 +144,7 @@ Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<
     i.announcements = i.addTopic<wire::MapAnnouncementPubSubType, wire::MapAnnouncement>(
         "tomomap/announcements", {true, false, 1, 0, 256}, h.announcement);
     i.slices = i.addTopic<wire::SliceFeaturesPubSubType, wire::SliceFeatures>(
-        "tomomap/slices", {false, true, 1, historySamples(config.bandwidth_kbps), 1},
+        "tomomap/slices", {true, false, 1, 0, kSliceInstances},
         [on = h.slice](wire::SliceFeatures&& s) {
           const size_t bytes = serializedSize(s);
           if (on) on(std::move(s), bytes);

@@ -47,6 +47,7 @@ namespace {
 
 constexpr size_t kMtuPayload = 1472;  ///< UDP payload of a 1500-byte Ethernet frame
 constexpr size_t kRtpsOverhead = 200; ///< RTPS header and DATA submessage around one sample
+constexpr int kLeaseS = 30;           ///< participant lease; announcements every tenth of it
 
 Locator_t udp(const std::string& host, uint16_t port) {
   Locator_t l;
@@ -86,9 +87,12 @@ DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipant
   builtin.metatrafficUnicastLocatorList.push_back(udp(c.address, c.discovery_port));
   q.wire_protocol().default_unicast_locator_list.push_back(udp(c.address, c.data_port));
   for (const auto& p : c.peers) builtin.initialPeersList.push_back(udp(p.host, p.port));
-  // A lost peer is noticed within seconds, so claims and transfers move on.
-  builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(6, 0);
-  builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(1, 0);
+  // A peer is dropped after this long without a word. Long enough to ride out
+  // a radio dropout: a dropped peer that comes back matches anew and gets our
+  // whole map from the durable history again, while a kept one gets repairs
+  // of just what was lost. Claims do not wait for it (claim_timeout_s).
+  builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(kLeaseS, 0);
+  builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(kLeaseS / 10, 0);
 
   auto flow = std::make_shared<eprosima::fastdds::rtps::FlowControllerDescriptor>();
   flow->name = kFlowControllerName;

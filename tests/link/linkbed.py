@@ -1,26 +1,37 @@
 #!/usr/bin/env python3
-"""A shaped-link test bed for tomomapd (needs root: network namespaces, tc).
+"""A shaped, lossy link test bed for tomomapd (needs root: network namespaces, tc, TUN).
 
-Each agent runs in a network namespace of its own, joined to the others by a
-veth pair into a bridge namespace. Each agent's egress is shaped with tbf (the
-kernel here has no netem). What really left each agent is read from its veth's
-tx_bytes once a second; the report gives, per agent, the total against the
-map's payload times its receivers and the peak over any 5 s window against the
-bandwidth budget, plus the time until every agent stores every pair.
+Each agent runs in a network namespace of its own whose only interface is a
+TUN device; a relay thread in this script carries the IP packets between them
+and loses, delays or cuts them as asked (the kernel here has no netem). Each
+agent's egress is shaped with tbf on its TUN device. What really left each
+agent is read from the device's tx_bytes once a second; the report gives, per
+agent, the total against the map's payload times its receivers and the peak
+over any 5 s window against the bandwidth budget, plus the time until every
+agent stores every pair.
 
-  linkbed.py --tomomapd BIN --tomomap BIN --agents 3 --rate-kbit 1000 --budget-kbps 800
+  linkbed.py --tomomapd BIN --tomomap BIN --agents 3 --rate-kbit 1000 --budget-kbps 800 \
+             [--loss 10 --delay-ms 50] [--dropout-at 15 --dropout-s 20]
 
 Every namespace it makes is deleted again, also on failure or Ctrl-C.
 """
 import argparse
+import ctypes
+import fcntl
+import heapq
 import json
 import os
+import random
 import re
+import select
 import shutil
 import signal
+import socket
+import struct
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 SUBNET = "10.77.0"  # exists only inside the namespaces this script makes
@@ -32,12 +43,103 @@ def run(*args, check=True):
     return subprocess.run(args, check=check, capture_output=True, text=True)
 
 
-class Bed:
-    """N agent namespaces and a bridge namespace, egress shaped per agent."""
+class Impairment:
+    """What the link does to a packet between agents: loss, delay, a dropout."""
 
-    def __init__(self, n, rate_kbit, prefix):
+    def __init__(self, loss_percent=0.0, delay_ms=0.0, dropout_at_s=None, dropout_s=0.0, seed=1):
+        self.loss = loss_percent / 100.0
+        self.delay = delay_ms / 1000.0
+        self.dropout_at, self.dropout_s = dropout_at_s, dropout_s
+        self.random = random.Random(seed)
+        self.t0 = time.monotonic()
+        self.dropped = self.passed = 0
+
+    def drops(self, now):
+        out = self.dropout_at is not None and self.dropout_at <= now - self.t0 < self.dropout_at + self.dropout_s
+        if out or self.random.random() < self.loss:
+            self.dropped += 1
+            return True
+        self.passed += 1
+        return False
+
+
+class Relay(threading.Thread):
+    """The link between the agents, in user space (the kernel here has no netem).
+
+    Each agent's namespace gets a TUN device as its only interface; this thread
+    reads the IP packets an agent sends into it, drops or delays them as the
+    Impairment says, and writes them into the TUN device of the agent that owns
+    the destination address. Egress shaping (tbf) sits on each TUN device, so
+    its tx counters are what left the agent.
+    """
+
+    TUNSETIFF = 0x400454CA
+    IFF_TUN, IFF_NO_PI = 0x0001, 0x1000
+    CLONE_NEWNET = 0x40000000
+
+    def __init__(self, impairment):
+        super().__init__(daemon=True)
+        self.impairment = impairment
+        self.fds = {}  # destination IPv4 address (4 bytes) -> TUN fd
+        self.running = True
+        self.libc = ctypes.CDLL(None, use_errno=True)
+
+    def attach(self, netns, address, name="v0"):
+        """Creates TUN device `name` inside `netns` for `address` (4 bytes)."""
+        home = os.open("/proc/self/ns/net", os.O_RDONLY)
+        target = os.open(f"/run/netns/{netns}", os.O_RDONLY)
+        try:
+            if self.libc.setns(target, self.CLONE_NEWNET) != 0:
+                raise OSError(ctypes.get_errno(), "setns into " + netns)
+            fd = os.open("/dev/net/tun", os.O_RDWR)
+            fcntl.ioctl(fd, self.TUNSETIFF, struct.pack("16sH", name.encode(), self.IFF_TUN | self.IFF_NO_PI))
+        finally:
+            self.libc.setns(home, self.CLONE_NEWNET)
+            os.close(home)
+            os.close(target)
+        self.fds[address] = fd
+
+    def run(self):
+        pending = []  # heap of (due, seq, fd, packet)
+        seq = 0
+        sources = list(self.fds.values())
+        while self.running:
+            timeout = max(0.0, pending[0][0] - time.monotonic()) if pending else 0.2
+            readable, _, _ = select.select(sources, [], [], min(timeout, 0.2))
+            now = time.monotonic()
+            for fd in readable:
+                try:
+                    packet = os.read(fd, 65536)
+                except OSError:
+                    continue
+                if len(packet) < 20 or packet[0] >> 4 != 4:
+                    continue  # IPv4 only
+                out = self.fds.get(packet[16:20])
+                if out is None or self.impairment.drops(now):
+                    continue
+                seq += 1
+                heapq.heappush(pending, (now + self.impairment.delay, seq, out, packet))
+            while pending and pending[0][0] <= time.monotonic():
+                _, _, out, packet = heapq.heappop(pending)
+                try:
+                    os.write(out, packet)
+                except OSError:
+                    pass  # the receiving namespace is going away
+
+    def stop(self):
+        self.running = False
+        self.join(timeout=2)
+        for fd in self.fds.values():
+            os.close(fd)
+        self.fds = {}
+
+
+class Bed:
+    """N agent namespaces joined by the Relay, egress shaped per agent."""
+
+    def __init__(self, n, rate_kbit, prefix, impairment):
         self.n, self.rate_kbit, self.prefix = n, rate_kbit, prefix
-        self.bridge = f"{prefix}-br"
+        self.relay = Relay(impairment)
         self.made = []
 
     def ns(self, i):
@@ -48,31 +150,28 @@ class Bed:
 
     def up(self):
         self.down_stale()
-        run("ip", "netns", "add", self.bridge)
-        self.made.append(self.bridge)
-        run("ip", "-n", self.bridge, "link", "add", "br0", "type", "bridge")
-        run("ip", "-n", self.bridge, "link", "set", "br0", "up")
         for i in range(self.n):
             ns = self.ns(i)
             run("ip", "netns", "add", ns)
             self.made.append(ns)
-            run("ip", "link", "add", "v0", "netns", ns, "type", "veth", "peer", "name", f"p{i}", "netns", self.bridge)
+            self.relay.attach(ns, socket.inet_aton(self.address(i)))
             run("ip", "-n", ns, "addr", "add", f"{self.address(i)}/24", "dev", "v0")
             run("ip", "-n", ns, "link", "set", "lo", "up")
             run("ip", "-n", ns, "link", "set", "v0", "up")
-            run("ip", "-n", self.bridge, "link", "set", f"p{i}", "master", "br0")
-            run("ip", "-n", self.bridge, "link", "set", f"p{i}", "up")
             # burst: a few full-size datagrams; latency bounds the queue.
             run("tc", "-n", ns, "qdisc", "add", "dev", "v0", "root", "tbf", "rate", f"{self.rate_kbit}kbit",
                 "burst", "16kb", "latency", "500ms")
+        self.relay.start()
 
     def down_stale(self):
         for line in run("ip", "netns", "list").stdout.splitlines():
             name = line.split()[0] if line.split() else ""
-            if name == self.bridge or re.fullmatch(re.escape(self.prefix) + r"-\d+", name):
+            if re.fullmatch(re.escape(self.prefix) + r"-\d+", name):
                 run("ip", "netns", "del", name, check=False)
 
     def down(self):
+        if self.relay.is_alive():
+            self.relay.stop()
         for ns in reversed(self.made):
             run("ip", "netns", "del", ns, check=False)
         self.made = []
@@ -124,11 +223,17 @@ def main():
     p.add_argument("--scale", type=float, default=0.5, help="synth world length factor")
     p.add_argument("--grid", type=float, default=0.1)
     p.add_argument("--seed", type=int, default=4)
-    p.add_argument("--loss", type=int, default=0, help="percent of sent RTPS messages each agent drops")
+    p.add_argument("--loss", type=float, default=0, help="percent of packets the link loses (every kind, both ways)")
+    p.add_argument("--delay-ms", type=float, default=0, help="one-way delay the link adds")
+    p.add_argument("--dropout-at", type=float, help="the link carries nothing from this second after start ...")
+    p.add_argument("--dropout-s", type=float, default=20, help="... for this long")
+    p.add_argument("--dds-drop", type=int, default=0,
+                   help="percent of RTPS messages each agent's own lossy test transport drops (test_drop_percent)")
     p.add_argument("--timeout", type=float, default=600)
     p.add_argument("--prefix", default="tmlink")
     p.add_argument("--json", help="write the report here")
-    p.add_argument("--max-wire-ratio", type=float, help="fail if an agent's wire bytes exceed this x payload x receivers")
+    p.add_argument("--max-wire-ratio", type=float,
+                   help="fail if an agent's wire bytes exceed this x payload x receivers / (1 - loss)")
     p.add_argument("--max-peak-ratio", type=float, help="fail if an agent's peak 5 s egress exceeds this x budget")
     p.add_argument("--keep", help="keep configs, logs and state in this folder")
     args = p.parse_args()
@@ -145,22 +250,24 @@ def main():
         print(gen.stdout + gen.stderr, file=sys.stderr)
         return 2
 
-    bed = Bed(n, args.rate_kbit, args.prefix)
+    bed = Bed(n, args.rate_kbit, args.prefix, Impairment(args.loss, args.delay_ms, args.dropout_at, args.dropout_s))
     procs = []
     stop = {"now": False}
     signal.signal(signal.SIGTERM, lambda *_: stop.update(now=True))
     report = {"agents": n, "rate_kbit": args.rate_kbit, "budget_kbps": args.budget_kbps, "loss_percent": args.loss,
-              "per_agent": {}}
+              "delay_ms": args.delay_ms, "dropout": [args.dropout_at, args.dropout_s] if args.dropout_at else None,
+              "dds_drop_percent": args.dds_drop, "per_agent": {}}
     try:
         bed.up()
         for i in range(n):
             cfg = f"{work}/a{i}.toml"
             write_config(cfg, i, n, bed, f"{work}/world/map_{i}.pcd", f"{work}/out-a{i}", args.budget_kbps,
-                         [f"grid = {args.grid}", f"test_drop_percent = {args.loss}"])
+                         [f"grid = {args.grid}", f"test_drop_percent = {args.dds_drop}"])
             log = open(f"{work}/a{i}.log", "w")
             procs.append(subprocess.Popen(["ip", "netns", "exec", bed.ns(i), args.tomomapd, "--config", cfg],
                                           stdout=log, stderr=subprocess.STDOUT))
         t0 = time.monotonic()
+        bed.relay.impairment.t0 = t0  # a dropout counts from the agents' start
         base = [bed.tx_bytes(i) for i in range(n)]
         samples = [[(0.0, 0)] for _ in range(n)]
         pairs = n * (n - 1) // 2
@@ -177,6 +284,7 @@ def main():
             if any(proc.poll() is not None for proc in procs):
                 break
         report["seconds_to_agreement"] = agreed_at
+        report["link_packets"] = {"passed": bed.relay.impairment.passed, "dropped": bed.relay.impairment.dropped}
         for i in range(n):
             status = read_json(f"{work}/out-a{i}/status.json") or {}
             payload = status.get("map", {}).get("payload_bytes", 0)
@@ -205,7 +313,10 @@ def main():
             shutil.rmtree(work, ignore_errors=True)
 
     t = report["seconds_to_agreement"]
-    print(f"{n} agents, tbf {args.rate_kbit} kbit/s, budget {args.budget_kbps} kbit/s, {args.loss} % loss: "
+    link = report["link_packets"]
+    print(f"{n} agents, tbf {args.rate_kbit} kbit/s, budget {args.budget_kbps} kbit/s, {args.loss} % loss, "
+          f"{args.delay_ms} ms delay" + (f", {args.dropout_s} s dropout at {args.dropout_at} s" if args.dropout_at else "")
+          + f" ({link['dropped']} of {link['passed'] + link['dropped']} packets lost): "
           + (f"every pair agreed after {t:.1f} s" if t is not None else "NO AGREEMENT"))
     for a, r in report["per_agent"].items():
         print(f"  {a}: payload {r['payload_bytes']} B, on the wire {r['wire_bytes']} B "
@@ -216,10 +327,12 @@ def main():
         with open(args.json, "w") as f:
             json.dump(report, f, indent=2)
     failures = [] if t is not None else ["no agreement within the timeout"]
+    # What is lost must be sent again: the bound grows by 1 / (1 - loss).
+    wire_bound = args.max_wire_ratio / (1 - args.loss / 100) if args.max_wire_ratio else None
     for a, r in report["per_agent"].items():
-        if args.max_wire_ratio and r["wire_per_payload_per_receiver"] > args.max_wire_ratio:
+        if wire_bound and r["wire_per_payload_per_receiver"] > wire_bound:
             failures.append(f"{a}: {r['wire_per_payload_per_receiver']:.2f} x payload x receivers on the wire "
-                            f"(bound {args.max_wire_ratio})")
+                            f"(bound {wire_bound:.2f})")
         if args.max_peak_ratio and r["peak_5s_kbit"] > args.max_peak_ratio * args.budget_kbps:
             failures.append(f"{a}: peak {r['peak_5s_kbit']:.0f} kbit/s over {WINDOW_S} s "
                             f"(bound {args.max_peak_ratio} x {args.budget_kbps})")

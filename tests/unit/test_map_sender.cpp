@@ -1,6 +1,7 @@
 // Sending one's own map without a network: requests queue slices once, a
-// slice still leaving the flow controller is not queued again, a full writer
-// holds the rest for later, and a new map version drops the old queue.
+// slice still on its way (leaving the flow controller, or coming to a late
+// reader from the writer's history) is not queued again, a full writer holds
+// the rest for later, and a new map version drops the old queue.
 #include <gtest/gtest.h>
 
 #include "map_sender.hpp"
@@ -53,8 +54,8 @@ const Clock::time_point t0{};
 TEST(MapSender, SendsWhatWasAskedForOnceInOrder) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(3, 2, 9));
-  EXPECT_EQ(m.request(9, {2, 0}, t0), 2u);
-  EXPECT_EQ(m.request(9, {0}, t0), 1u) << "asked twice before it left: queued once";
+  EXPECT_EQ(m.request("bravo", 9, {2, 0}, t0), 2u);
+  EXPECT_EQ(m.request("bravo", 9, {0}, t0), 1u) << "asked twice before it left: queued once";
   EXPECT_EQ(m.queued(), 2u);
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
@@ -67,22 +68,22 @@ TEST(MapSender, SendsWhatWasAskedForOnceInOrder) {
 TEST(MapSender, ASliceStillOnItsWayIsNotSentAgain) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(2, 1, 9));
-  m.request(9, {}, t0);  // everything
+  m.request("bravo", 9, {}, t0);  // everything
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
   ASSERT_EQ(w.sent.size(), 2u);
   // Slice 1 leaves the controller at 0.2 s; with 1 s of grace a request before
   // 1.2 s crossed it, a later one means it was lost.
-  m.request(9, {1}, t0 + 1100ms);
+  m.request("bravo", 9, {1}, t0 + 1100ms);
   EXPECT_EQ(m.queued(), 0u);
-  m.request(9, {1}, t0 + 1300ms);
+  m.request("bravo", 9, {1}, t0 + 1300ms);
   EXPECT_EQ(m.queued(), 1u);
 }
 
 TEST(MapSender, AFullWriterHoldsTheRestForTheNextCall) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(2, 2, 9));
-  m.request(9, {}, t0);
+  m.request("bravo", 9, {}, t0);
   Wire w;
   w.room = 3;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
@@ -97,10 +98,43 @@ TEST(MapSender, AFullWriterHoldsTheRestForTheNextCall) {
 TEST(MapSender, ANewVersionDropsTheOldQueueAndOldRequests) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(3, 1, 9));
-  m.request(9, {}, t0);
+  m.request("bravo", 9, {}, t0);
   m.setOffer(fakeOffer(3, 1, 10));
   EXPECT_EQ(m.queued(), 0u);
-  EXPECT_EQ(m.request(9, {0, 1}, t0), 0u) << "a request for the old version";
-  EXPECT_EQ(m.request(10, {0, 7}, t0), 1u) << "slice 7 does not exist";
+  EXPECT_EQ(m.request("bravo", 9, {0, 1}, t0), 0u) << "a request for the old version";
+  EXPECT_EQ(m.request("bravo", 10, {0, 7}, t0), 1u) << "slice 7 does not exist";
   EXPECT_EQ(m.queued(), 1u);
+}
+
+TEST(MapSender, ALateReaderGetsTheHistoryInsteadOfAResend) {
+  MapSender m(80, 1s);
+  m.setOffer(fakeOffer(4, 1, 9));
+  m.request("bravo", 9, {}, t0);
+  Wire w;
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  ASSERT_EQ(w.sent.size(), 4u);  // leave at 0.1 ... 0.4 s
+  // charlie matched after they left and asks for everything at 2 s: the
+  // history reaches it at the stream's rate (0.4 s) plus the grace: by 3.4 s.
+  m.request("charlie", 9, {}, t0 + 2s);
+  EXPECT_EQ(m.queued(), 0u) << "the durable history is on its way to charlie";
+  m.request("charlie", 9, {3}, t0 + 3s);
+  EXPECT_EQ(m.queued(), 0u) << "still within charlie's window";
+  m.request("charlie", 9, {3}, t0 + 3500ms);
+  EXPECT_EQ(m.queued(), 1u) << "overdue: lost at charlie, sent again";
+  EXPECT_EQ(m.resends(), 1u);
+}
+
+TEST(MapSender, AStalledReaderIsAnsweredOnceItsCopyIsOverdue) {
+  MapSender m(80, 1s);
+  m.setOffer(fakeOffer(2, 1, 9));
+  m.request("bravo", 9, {}, t0);  // before anything was written: its window is the grace
+  Wire w;
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  m.request("bravo", 9, {0}, t0 + 500ms);
+  EXPECT_EQ(m.queued(), 0u) << "slice 0 left at 0.1 s: crossed";
+  m.request("bravo", 9, {0}, t0 + 1200ms);
+  EXPECT_EQ(m.queued(), 1u);
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 1200ms);
+  m.request("bravo", 9, {0}, t0 + 1500ms);
+  EXPECT_EQ(m.queued(), 0u) << "the resend is on its way";
 }
