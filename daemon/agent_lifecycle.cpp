@@ -12,7 +12,7 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr auto kTick = std::chrono::milliseconds(50);
-constexpr auto kReannounce = std::chrono::seconds(5);
+constexpr auto kReannounce = std::chrono::seconds(30);
 constexpr auto kStatusEvery = std::chrono::seconds(1);
 /// A map file must be quiet this long before it is read: writers that open,
 /// write and close it several times are done by then.
@@ -119,7 +119,9 @@ void Agent::tick(Clock::time_point& last_announce) {
   finishCompute();
   followMapFile();
   const auto now = Clock::now();
-  sender_.pump([this](const wire::SliceFeatures& x) { return bus_->publish(x); }, transport::Bus::serializedSize, now);
+  if (sender_.mayStart(bus_->sliceReaders(), peers_.aliveCount(), now))
+    sender_.pump([this](const wire::SliceFeatures& x) { return bus_->publish(x); }, transport::Bus::serializedSize,
+                 now);
   requestMissing();
   claimAndCompute();
   if (now - last_announce > kReannounce) {  // repairs a lost or missed announcement

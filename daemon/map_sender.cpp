@@ -18,12 +18,18 @@ void MapSender::setOffer(transport::MapOffer offer) {
   next_part_ = 0;
   leaves_at_.clear();
   expected_until_.clear();
-  slice_bytes_.clear();
+  queued_since_.reset();
 }
 
 Clock::duration MapSender::leaveTime(size_t bytes) const {
   return std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(static_cast<double>(bytes) * 8 / 1000 / kbps_));
+}
+
+size_t MapSender::sliceBytes(int slice) const {
+  for (const auto& e : offer_.announcement.slices())
+    if (e.slice() == slice) return e.bytes();
+  return 0;
 }
 
 size_t MapSender::request(const std::string& requester, uint64_t version, const std::vector<int32_t>& slices,
@@ -36,29 +42,42 @@ size_t MapSender::request(const std::string& requester, uint64_t version, const 
     for (int32_t k : slices)
       if (offer_.samples.count(k)) wanted.push_back(k);
 
-  // The first request from this requester since slices were written: it may
-  // have matched after they left, and then gets them from the history once
-  // the backlog has gone, at the stream's rate.
-  size_t written_bytes = 0;
-  for (int k : wanted)
-    if (const auto b = slice_bytes_.find(k); b != slice_bytes_.end()) written_bytes += b->second;
-  auto [expected, first] = expected_until_.try_emplace(requester);
-  if (first) expected->second = std::max(backlog_until_, now) + leaveTime(written_bytes) + grace_;
-  const bool overdue = now >= expected->second;
-
+  // Within the requester's window the copies written are still on their way
+  // (live, repaired, or from the history if it matched late): only slices
+  // never written are queued. A request after the window sends again what
+  // left long enough ago, and opens a new window.
+  // A first request never sends again: the requester may have matched after
+  // the slices left, and then the history is on its way to it.
+  auto [entry, first] = expected_until_.try_emplace(requester);
+  Clock::time_point& until = entry->second;
+  const bool open = now >= until;
   size_t resent = 0;
   for (int k : wanted) {
     const auto left = leaves_at_.find(k);
     if (left != leaves_at_.end()) {
-      if (now < left->second + grace_ || !overdue) continue;  // a copy is still on its way
+      if (first || !open || now < left->second + grace_) continue;
       ++resent;
     }
     if (queued_.insert(k).second) queue_.push_back(k);
   }
   resends_ += resent;
-  // What is sent again now is expected once it has left.
-  if (resent) expected->second = std::max(backlog_until_, now) + leaveTime(written_bytes) + grace_;
+  if (open) {
+    // Everything queued leaves first; then a late reader gets the history of
+    // what it asked for; losses are repaired after that (kRepairSlack).
+    size_t bytes = 0;
+    for (int k : queue_) bytes += sliceBytes(k);
+    for (int k : wanted)
+      if (!queued_.count(k)) bytes += sliceBytes(k);
+    until = std::max(backlog_until_, now) +
+            std::chrono::duration_cast<Clock::duration>(kRepairSlack * leaveTime(bytes)) + grace_;
+  }
   return wanted.size();
+}
+
+bool MapSender::mayStart(size_t matched_readers, size_t alive_peers, Clock::time_point now) {
+  if (queue_.empty()) return false;
+  if (!queued_since_) queued_since_ = now;
+  return matched_readers >= alive_peers || now >= *queued_since_ + kMatchWait;
 }
 
 void MapSender::pump(const std::function<bool(const wire::SliceFeatures&)>& publish,
@@ -73,14 +92,13 @@ void MapSender::pump(const std::function<bool(const wire::SliceFeatures&)>& publ
     ++samples_sent_;
     backlog_until_ = std::max(backlog_until_, now) + leaveTime(bytes);
     leaves_at_[k] = backlog_until_;
-    if (next_part_ == 0) slice_bytes_[k] = 0;
-    slice_bytes_[k] += bytes;
     if (++next_part_ == samples.size()) {
       next_part_ = 0;
       queue_.pop_front();
       queued_.erase(k);
     }
   }
+  queued_since_.reset();
 }
 
 }  // namespace tomomap::daemon

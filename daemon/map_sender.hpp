@@ -14,6 +14,7 @@
 #include <deque>
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -43,6 +44,12 @@ class MapSender {
   size_t request(const std::string& requester, uint64_t version, const std::vector<int32_t>& slices,
                  Clock::time_point now);
 
+  /// Whether to start sending what is queued: once every live peer's reader
+  /// has matched the writer (a reader that matches later gets the slices
+  /// from the history, but only after everything else queued), or after
+  /// kMatchWait.
+  bool mayStart(size_t matched_readers, size_t alive_peers, Clock::time_point now);
+
   /// Hands queued parts to `publish` in order until it refuses one (the
   /// writer is full: the rest goes on a later call). `size` gives a sample's
   /// bytes on the wire.
@@ -56,7 +63,13 @@ class MapSender {
   size_t resends() const { return resends_; }
 
  private:
+  /// Repairs of lost samples follow the rest: a window is this many times
+  /// the time its bytes take to leave.
+  static constexpr double kRepairSlack = 1.5;
+  static constexpr Clock::duration kMatchWait = std::chrono::seconds(5);
+
   Clock::duration leaveTime(size_t bytes) const;
+  size_t sliceBytes(int slice) const;  ///< payload bytes of a slice, as announced
 
   double kbps_;
   Clock::duration grace_;
@@ -71,8 +84,8 @@ class MapSender {
   /// Per requester: until when copies already written may still be on their
   /// way to it (a late reader gets the history after the backlog).
   std::map<std::string, Clock::time_point> expected_until_;
+  std::optional<Clock::time_point> queued_since_;  ///< when the queue last had something waiting to start
   size_t bytes_sent_ = 0, samples_sent_ = 0, resends_ = 0;
-  std::map<int, size_t> slice_bytes_;  ///< bytes of each written slice, as `size` gave them
 };
 
 }  // namespace tomomap::daemon

@@ -87,8 +87,8 @@ DataWriterQos writerQos(const TopicQos& t) {
 /// payload at the smallest sample size, far above any map sent so far.
 constexpr int kSliceInstances = 1 << 16;
 
-constexpr uint32_t kHeartbeatMs = 500;        ///< slice writer's heartbeat period
-constexpr uint32_t kNackSuppressionMs = 500;  ///< longer than a link's round trip plus a queue's wait
+constexpr double kHeartbeatMs = 1000;         ///< slice writer's heartbeat period (Duration_t takes nanoseconds < 1e9 only)
+constexpr double kNackSuppressionMs = 500;    ///< longer than a link's round trip plus a queue's wait
 
 }  // namespace
 
@@ -114,14 +114,13 @@ struct Bus::Impl {
       wq.publish_mode().flow_controller_name = kFlowControllerName;
       // Repairs follow heartbeats (every 3 s by default): ask often, so a lost
       // sample is sent again within a fraction of a second.
-      wq.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, kHeartbeatMs * 1000000);
+      wq.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(kHeartbeatMs / 1000.0);
       // A reader repeats its negative acknowledgement with every heartbeat
       // until the repair arrives; with a link delay and a queue in front of
       // the repair, each repeat sent the sample again (10 % loss and 50 ms
       // delay: up to 11 x the map on the wire). Repeats within this time of a
       // repair's departure are ignored.
-      wq.reliable_writer_qos().times.nackSupressionDuration =
-          eprosima::fastrtps::Duration_t(0, kNackSuppressionMs * 1000000);
+      wq.reliable_writer_qos().times.nackSupressionDuration = eprosima::fastrtps::Duration_t(kNackSuppressionMs / 1000.0);
     }
     DataWriter* w = publisher->create_datawriter(topic, wq);
     if (!w) throw std::runtime_error("cannot create the writer of " + name);
@@ -178,6 +177,13 @@ bool Bus::publish(const wire::ChunkRequest& r) { return impl_->requests->write(c
 bool Bus::publish(const wire::MatchClaim& c) { return impl_->claims->write(const_cast<wire::MatchClaim*>(&c)); }
 bool Bus::publish(const wire::TransformEstimate& e) {
   return impl_->estimates->write(const_cast<wire::TransformEstimate*>(&e));
+}
+
+size_t Bus::sliceReaders() const {
+  PublicationMatchedStatus status;
+  if (impl_->slices->get_publication_matched_status(status) != ReturnCode_t::RETCODE_OK) return 0;
+  // Our own reader matches our writer too.
+  return status.current_count > 0 ? static_cast<size_t>(status.current_count - 1) : 0;
 }
 
 size_t Bus::serializedSize(const wire::SliceFeatures& s) { return wire::SliceFeatures::getCdrSerializedSize(s) + 4; }

@@ -38,6 +38,8 @@ class Bus {
   bool publish(const wire::ChunkRequest& r);
   bool publish(const wire::MatchClaim& c);
   bool publish(const wire::TransformEstimate& e);
+  /// Peers' slice readers matched to our slice writer now.
+  size_t sliceReaders() const;
   /// Serialised size of a slice sample [bytes].
   static size_t serializedSize(const wire::SliceFeatures& s);
 

@@ -32,22 +32,29 @@ int flowPeriodMs(const TransportConfig& c) {
   return kFlowPeriodMs * static_cast<int>(std::max<size_t>(1, c.peers.size()));
 }
 
+namespace {
+
+constexpr size_t kMtuPayload = 1472;  ///< UDP payload of a 1500-byte Ethernet frame
+/// RTPS around one sample in a datagram: header, INFO_TS, DATA submessage with
+/// the key hash inline (about 100 bytes seen), with a margin.
+constexpr size_t kRtpsOverhead = 128;
+constexpr int kLeaseS = 60;  ///< participant lease; announcements every tenth of it
+
+}  // namespace
+
 size_t maxSampleBytes(double kbps) {
   // The controller sends whole samples only and a sample that does not fit the
   // rest of a period waits for the next one. Slices vary in size, so with
   // samples of up to an eighth of the period's budget at most about one
   // eighth of a period goes unused (one sample per period as at first lost up
-  // to half). And no sample may exceed one UDP datagram.
+  // to half). Thin budgets: one sample fills one Ethernet-sized datagram (each
+  // datagram costs its headers; smaller samples paid them more often). And no
+  // sample may exceed one UDP datagram.
   constexpr size_t kDatagram = 60000;
-  constexpr size_t kHeaders = 200;  // RTPS message and submessage headers: the controller counts them
-  return std::clamp<size_t>(bytesPerPeriod(kbps) / 8 - kHeaders, 1024, kDatagram);
+  return std::clamp<size_t>(bytesPerPeriod(kbps) / 8, kMtuPayload, kDatagram) - kRtpsOverhead;
 }
 
 namespace {
-
-constexpr size_t kMtuPayload = 1472;  ///< UDP payload of a 1500-byte Ethernet frame
-constexpr size_t kRtpsOverhead = 200; ///< RTPS header and DATA submessage around one sample
-constexpr int kLeaseS = 30;           ///< participant lease; announcements every tenth of it
 
 Locator_t udp(const std::string& host, uint16_t port) {
   Locator_t l;

@@ -20,6 +20,7 @@ transport::MapOffer fakeOffer(int slices, int parts, uint64_t version) {
     wire::SliceEntry e;
     e.slice(k);
     e.parts(static_cast<uint16_t>(parts));
+    e.bytes(static_cast<uint32_t>(1000 * parts));
     o.announcement.slices().push_back(e);
     for (int p = 0; p < parts; ++p) {
       wire::SliceFeatures s;
@@ -72,11 +73,12 @@ TEST(MapSender, ASliceStillOnItsWayIsNotSentAgain) {
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
   ASSERT_EQ(w.sent.size(), 2u);
-  // Slice 1 leaves the controller at 0.2 s; with 1 s of grace a request before
-  // 1.2 s crossed it, a later one means it was lost.
+  // Slice 1 leaves the controller at 0.2 s. bravo's window: both slices
+  // leave (0.2 s) with repair slack (x 1.5) plus 1 s of grace: a request
+  // before 1.3 s crossed them, a later one means slice 1 was lost.
   m.request("bravo", 9, {1}, t0 + 1100ms);
   EXPECT_EQ(m.queued(), 0u);
-  m.request("bravo", 9, {1}, t0 + 1300ms);
+  m.request("bravo", 9, {1}, t0 + 1400ms);
   EXPECT_EQ(m.queued(), 1u);
 }
 
@@ -114,12 +116,13 @@ TEST(MapSender, ALateReaderGetsTheHistoryInsteadOfAResend) {
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
   ASSERT_EQ(w.sent.size(), 4u);  // leave at 0.1 ... 0.4 s
   // charlie matched after they left and asks for everything at 2 s: the
-  // history reaches it at the stream's rate (0.4 s) plus the grace: by 3.4 s.
+  // history reaches it at the stream's rate (0.4 s) with repair slack (x 1.5)
+  // plus the grace: by 3.6 s.
   m.request("charlie", 9, {}, t0 + 2s);
   EXPECT_EQ(m.queued(), 0u) << "the durable history is on its way to charlie";
   m.request("charlie", 9, {3}, t0 + 3s);
   EXPECT_EQ(m.queued(), 0u) << "still within charlie's window";
-  m.request("charlie", 9, {3}, t0 + 3500ms);
+  m.request("charlie", 9, {3}, t0 + 3700ms);
   EXPECT_EQ(m.queued(), 1u) << "overdue: lost at charlie, sent again";
   EXPECT_EQ(m.resends(), 1u);
 }
@@ -127,14 +130,24 @@ TEST(MapSender, ALateReaderGetsTheHistoryInsteadOfAResend) {
 TEST(MapSender, AStalledReaderIsAnsweredOnceItsCopyIsOverdue) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(2, 1, 9));
-  m.request("bravo", 9, {}, t0);  // before anything was written: its window is the grace
+  m.request("bravo", 9, {}, t0);  // window: 0.2 s x 1.5 + 1 s of grace
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
   m.request("bravo", 9, {0}, t0 + 500ms);
   EXPECT_EQ(m.queued(), 0u) << "slice 0 left at 0.1 s: crossed";
-  m.request("bravo", 9, {0}, t0 + 1200ms);
+  m.request("bravo", 9, {0}, t0 + 1400ms);
   EXPECT_EQ(m.queued(), 1u);
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 1200ms);
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 1400ms);
   m.request("bravo", 9, {0}, t0 + 1500ms);
   EXPECT_EQ(m.queued(), 0u) << "the resend is on its way";
+}
+
+TEST(MapSender, StartsOnceEveryLivePeerHasMatchedOrAfterAWait) {
+  MapSender m(80, 1s);
+  m.setOffer(fakeOffer(2, 1, 9));
+  EXPECT_FALSE(m.mayStart(2, 2, t0)) << "nothing queued";
+  m.request("bravo", 9, {}, t0);
+  EXPECT_FALSE(m.mayStart(1, 2, t0)) << "charlie is up but its reader has not matched yet";
+  EXPECT_TRUE(m.mayStart(2, 2, t0 + 1s));
+  EXPECT_TRUE(m.mayStart(1, 2, t0 + 6s)) << "a reader that never matches does not hold the others back";
 }
