@@ -4,10 +4,11 @@
 
 namespace tomomap::daemon {
 
-MapSender::MapSender(double stream_kbps, Clock::duration grace) : kbps_(stream_kbps), grace_(grace) {}
+MapSender::MapSender(double stream_kbps, Clock::duration grace)
+    : kbps_(stream_kbps * (1 - kRepairShare)), grace_(grace) {}
 
 void MapSender::setBudget(double stream_kbps, Clock::duration grace) {
-  kbps_ = stream_kbps;
+  kbps_ = stream_kbps * (1 - kRepairShare);
   grace_ = grace;
 }
 
@@ -82,7 +83,10 @@ bool MapSender::mayStart(size_t matched_readers, size_t alive_peers, Clock::time
 
 void MapSender::pump(const std::function<bool(const wire::SliceFeatures&)>& publish,
                      const std::function<size_t(const wire::SliceFeatures&)>& size, Clock::time_point now) {
-  while (!queue_.empty()) {
+  // Fed no faster than kbps_ and at most kFeedAhead ahead, the controller's
+  // queue of new samples runs dry now and then; only then does it send repairs
+  // and history for late readers (it serves new samples first).
+  while (!queue_.empty() && backlog_until_ <= now + kFeedAhead) {
     const int k = queue_.front();
     const auto& samples = offer_.samples.at(k);
     const wire::SliceFeatures& sample = samples[next_part_];
@@ -98,7 +102,7 @@ void MapSender::pump(const std::function<bool(const wire::SliceFeatures&)>& publ
       queued_.erase(k);
     }
   }
-  queued_since_.reset();
+  if (queue_.empty()) queued_since_.reset();
 }
 
 }  // namespace tomomap::daemon

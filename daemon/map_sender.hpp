@@ -26,8 +26,9 @@ namespace tomomap::daemon {
 class MapSender {
  public:
   /// `stream_kbps`: the rate the flow controller lets each written byte leave
-  /// at (transport::streamKbps); `grace`: how long after a copy's expected
-  /// arrival a request for it is still taken as crossed.
+  /// at (transport::streamKbps), of which new samples get 1 - kRepairShare;
+  /// `grace`: how long after a copy's expected arrival a request for it is
+  /// still taken as crossed.
   MapSender(double stream_kbps, Clock::duration grace);
   void setBudget(double stream_kbps, Clock::duration grace);
 
@@ -50,9 +51,10 @@ class MapSender {
   /// kMatchWait.
   bool mayStart(size_t matched_readers, size_t alive_peers, Clock::time_point now);
 
-  /// Hands queued parts to `publish` in order until it refuses one (the
-  /// writer is full: the rest goes on a later call). `size` gives a sample's
-  /// bytes on the wire.
+  /// Hands queued parts to `publish` in order, paced at the stream's rate for
+  /// new samples and at most kFeedAhead ahead of `now`, until it refuses one
+  /// (the writer is full): the rest goes on later calls. `size` gives a
+  /// sample's bytes on the wire.
   void pump(const std::function<bool(const wire::SliceFeatures&)>& publish,
             const std::function<size_t(const wire::SliceFeatures&)>& size, Clock::time_point now);
 
@@ -66,6 +68,12 @@ class MapSender {
   /// Repairs of lost samples follow the rest: a window is this many times
   /// the time its bytes take to leave.
   static constexpr double kRepairSlack = 1.5;
+  /// Share of the stream's rate kept free of new samples, for RTPS repairs
+  /// and for the history a late reader gets: the flow controller serves those
+  /// only when no new sample waits, and a reader delivers in order, so a
+  /// repair held back to the end of the map stalled everything after a loss.
+  static constexpr double kRepairShare = 0.15;
+  static constexpr Clock::duration kFeedAhead = std::chrono::milliseconds(500);
   static constexpr Clock::duration kMatchWait = std::chrono::seconds(5);
 
   Clock::duration leaveTime(size_t bytes) const;

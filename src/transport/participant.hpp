@@ -56,8 +56,9 @@ extern const char* const kFlowControllerName;
 size_t bytesPerPeriod(double bandwidth_kbps);
 
 /// Largest slice sample: a fraction of the per-period budget, so that the
-/// controller, which sends only whole samples per period (FASTDDS-NOTES.md),
-/// fills each period nearly to the budget.
+/// controller, which sends only whole samples per period, fills each period
+/// nearly to the budget; but at thin budgets one full Ethernet datagram, since
+/// each datagram pays its headers (docs/protocol.md, "Sample size").
 size_t maxSampleBytes(double bandwidth_kbps);
 
 /// Creates the participant; throws std::runtime_error naming the cause.

@@ -34,7 +34,8 @@ transport::MapOffer fakeOffer(int slices, int parts, uint64_t version) {
   return o;
 }
 
-/// 1000 bytes a sample at 80 kbit/s: each sample takes 0.1 s to leave.
+/// 1000 bytes a sample at 80 kbit/s, of which new samples get 85 %: each
+/// sample takes about 0.12 s to leave.
 size_t thousand(const wire::SliceFeatures&) { return 1000; }
 
 struct Wire {
@@ -73,9 +74,9 @@ TEST(MapSender, ASliceStillOnItsWayIsNotSentAgain) {
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
   ASSERT_EQ(w.sent.size(), 2u);
-  // Slice 1 leaves the controller at 0.2 s. bravo's window: both slices
-  // leave (0.2 s) with repair slack (x 1.5) plus 1 s of grace: a request
-  // before 1.3 s crossed them, a later one means slice 1 was lost.
+  // Slice 1 leaves the controller at 0.24 s. bravo's window: both slices
+  // leave (0.24 s) with repair slack (x 1.5) plus 1 s of grace: a request
+  // before 1.35 s crossed them, a later one means slice 1 was lost.
   m.request("bravo", 9, {1}, t0 + 1100ms);
   EXPECT_EQ(m.queued(), 0u);
   m.request("bravo", 9, {1}, t0 + 1400ms);
@@ -114,15 +115,15 @@ TEST(MapSender, ALateReaderGetsTheHistoryInsteadOfAResend) {
   m.request("bravo", 9, {}, t0);
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
-  ASSERT_EQ(w.sent.size(), 4u);  // leave at 0.1 ... 0.4 s
+  ASSERT_EQ(w.sent.size(), 4u);  // leave at 0.12 ... 0.47 s
   // charlie matched after they left and asks for everything at 2 s: the
-  // history reaches it at the stream's rate (0.4 s) with repair slack (x 1.5)
-  // plus the grace: by 3.6 s.
+  // history reaches it at the stream's rate (0.47 s) with repair slack
+  // (x 1.5) plus the grace: by 3.7 s.
   m.request("charlie", 9, {}, t0 + 2s);
   EXPECT_EQ(m.queued(), 0u) << "the durable history is on its way to charlie";
   m.request("charlie", 9, {3}, t0 + 3s);
   EXPECT_EQ(m.queued(), 0u) << "still within charlie's window";
-  m.request("charlie", 9, {3}, t0 + 3700ms);
+  m.request("charlie", 9, {3}, t0 + 3800ms);
   EXPECT_EQ(m.queued(), 1u) << "overdue: lost at charlie, sent again";
   EXPECT_EQ(m.resends(), 1u);
 }
@@ -130,11 +131,11 @@ TEST(MapSender, ALateReaderGetsTheHistoryInsteadOfAResend) {
 TEST(MapSender, AStalledReaderIsAnsweredOnceItsCopyIsOverdue) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(2, 1, 9));
-  m.request("bravo", 9, {}, t0);  // window: 0.2 s x 1.5 + 1 s of grace
+  m.request("bravo", 9, {}, t0);  // window: 0.24 s x 1.5 + 1 s of grace
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
   m.request("bravo", 9, {0}, t0 + 500ms);
-  EXPECT_EQ(m.queued(), 0u) << "slice 0 left at 0.1 s: crossed";
+  EXPECT_EQ(m.queued(), 0u) << "slice 0 left at 0.12 s: crossed";
   m.request("bravo", 9, {0}, t0 + 1400ms);
   EXPECT_EQ(m.queued(), 1u);
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 1400ms);
@@ -150,4 +151,16 @@ TEST(MapSender, StartsOnceEveryLivePeerHasMatchedOrAfterAWait) {
   EXPECT_FALSE(m.mayStart(1, 2, t0)) << "charlie is up but its reader has not matched yet";
   EXPECT_TRUE(m.mayStart(2, 2, t0 + 1s));
   EXPECT_TRUE(m.mayStart(1, 2, t0 + 6s)) << "a reader that never matches does not hold the others back";
+}
+
+TEST(MapSender, FeedsTheWriterAtTheStreamRateLeavingRoomForRepairs) {
+  MapSender m(80, 1s);
+  m.setOffer(fakeOffer(20, 1, 9));
+  m.request("bravo", 9, {}, t0);
+  Wire w;
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  // 0.12 s a sample, at most 0.5 s ahead: five samples now, not twenty.
+  EXPECT_EQ(w.sent.size(), 5u);
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 1s);
+  EXPECT_EQ(w.sent.size(), 10u) << "the first five have left by 1 s: five more, 0.5 s ahead again";
 }
