@@ -70,7 +70,8 @@ size_t MapSender::request(const std::string& requester, uint64_t version, const 
     for (int k : wanted)
       if (!queued_.count(k)) bytes += sliceBytes(k);
     until = std::max(backlog_until_, now) +
-            std::chrono::duration_cast<Clock::duration>(kRepairSlack * leaveTime(bytes)) + grace_;
+            std::chrono::duration_cast<Clock::duration>(kRepairSlack * leaveTime(bytes)) +
+            fromSeconds(kRepairRounds * transport::kSliceHeartbeatS) + grace_;
   }
   return wanted.size();
 }

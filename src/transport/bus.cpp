@@ -87,7 +87,6 @@ DataWriterQos writerQos(const TopicQos& t) {
 /// payload at the smallest sample size, far above any map sent so far.
 constexpr int kSliceInstances = 1 << 16;
 
-constexpr double kHeartbeatMs = 1000;         ///< slice writer's heartbeat period (Duration_t takes nanoseconds < 1e9 only)
 constexpr double kNackSuppressionMs = 500;    ///< longer than a link's round trip plus a queue's wait
 
 }  // namespace
@@ -114,7 +113,7 @@ struct Bus::Impl {
       wq.publish_mode().flow_controller_name = kFlowControllerName;
       // Repairs follow heartbeats (every 3 s by default): ask often, so a lost
       // sample is sent again within a fraction of a second.
-      wq.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(kHeartbeatMs / 1000.0);
+      wq.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(kSliceHeartbeatS);
       // A reader repeats its negative acknowledgement with every heartbeat
       // until the repair arrives; with a link delay and a queue in front of
       // the repair, each repeat sent the sample again (10 % loss and 50 ms

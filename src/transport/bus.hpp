@@ -10,6 +10,10 @@
 
 namespace tomomap::transport {
 
+/// The slice writer's heartbeat period [s]: a lost sample is asked for again
+/// after the next heartbeat, so a repair takes about one period per attempt.
+constexpr double kSliceHeartbeatS = 1.0;
+
 struct BusHandlers {
   std::function<void(wire::MapAnnouncement&&)> announcement;
   /// `bytes`: serialised size of the sample, for transfer accounting.

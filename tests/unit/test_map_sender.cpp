@@ -75,11 +75,12 @@ TEST(MapSender, ASliceStillOnItsWayIsNotSentAgain) {
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
   ASSERT_EQ(w.sent.size(), 2u);
   // Slice 1 leaves the controller at 0.24 s. bravo's window: both slices
-  // leave (0.24 s) with repair slack (x 1.5) plus 1 s of grace: a request
-  // before 1.35 s crossed them, a later one means slice 1 was lost.
-  m.request("bravo", 9, {1}, t0 + 1100ms);
+  // leave (0.24 s) with repair slack (x 1.5), ten repair rounds (10 s) and
+  // 1 s of grace: a request before 11.35 s crossed them, a later one means
+  // slice 1 was lost.
+  m.request("bravo", 9, {1}, t0 + 11s);
   EXPECT_EQ(m.queued(), 0u);
-  m.request("bravo", 9, {1}, t0 + 1400ms);
+  m.request("bravo", 9, {1}, t0 + 11400ms);
   EXPECT_EQ(m.queued(), 1u);
 }
 
@@ -118,12 +119,12 @@ TEST(MapSender, ALateReaderGetsTheHistoryInsteadOfAResend) {
   ASSERT_EQ(w.sent.size(), 4u);  // leave at 0.12 ... 0.47 s
   // charlie matched after they left and asks for everything at 2 s: the
   // history reaches it at the stream's rate (0.47 s) with repair slack
-  // (x 1.5) plus the grace: by 3.7 s.
+  // (x 1.5), ten repair rounds and the grace: by 13.7 s.
   m.request("charlie", 9, {}, t0 + 2s);
   EXPECT_EQ(m.queued(), 0u) << "the durable history is on its way to charlie";
-  m.request("charlie", 9, {3}, t0 + 3s);
+  m.request("charlie", 9, {3}, t0 + 13s);
   EXPECT_EQ(m.queued(), 0u) << "still within charlie's window";
-  m.request("charlie", 9, {3}, t0 + 3800ms);
+  m.request("charlie", 9, {3}, t0 + 13800ms);
   EXPECT_EQ(m.queued(), 1u) << "overdue: lost at charlie, sent again";
   EXPECT_EQ(m.resends(), 1u);
 }
@@ -131,15 +132,15 @@ TEST(MapSender, ALateReaderGetsTheHistoryInsteadOfAResend) {
 TEST(MapSender, AStalledReaderIsAnsweredOnceItsCopyIsOverdue) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(2, 1, 9));
-  m.request("bravo", 9, {}, t0);  // window: 0.24 s x 1.5 + 1 s of grace
+  m.request("bravo", 9, {}, t0);  // window: 0.24 s x 1.5 + 10 s of repair rounds + 1 s of grace
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
-  m.request("bravo", 9, {0}, t0 + 500ms);
-  EXPECT_EQ(m.queued(), 0u) << "slice 0 left at 0.12 s: crossed";
-  m.request("bravo", 9, {0}, t0 + 1400ms);
+  m.request("bravo", 9, {0}, t0 + 5s);
+  EXPECT_EQ(m.queued(), 0u) << "slice 0 left at 0.12 s: RTPS is still repairing it";
+  m.request("bravo", 9, {0}, t0 + 11400ms);
   EXPECT_EQ(m.queued(), 1u);
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 1400ms);
-  m.request("bravo", 9, {0}, t0 + 1500ms);
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 11400ms);
+  m.request("bravo", 9, {0}, t0 + 11500ms);
   EXPECT_EQ(m.queued(), 0u) << "the resend is on its way";
 }
 
