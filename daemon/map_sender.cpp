@@ -34,7 +34,7 @@ size_t MapSender::sliceBytes(int slice) const {
 }
 
 size_t MapSender::request(const std::string& requester, uint64_t version, const std::vector<int32_t>& slices,
-                          Clock::time_point now) {
+                          Clock::duration stalled, Clock::time_point now) {
   if (version != offer_.announcement.version()) return 0;
   std::vector<int> wanted;
   if (slices.empty())
@@ -45,8 +45,9 @@ size_t MapSender::request(const std::string& requester, uint64_t version, const 
 
   // Within the requester's window the copies written are still on their way
   // (live, repaired, or from the history if it matched late): only slices
-  // never written are queued. A request after the window sends again what
-  // left long enough ago, and opens a new window.
+  // never written are queued. A request after the window from a requester
+  // that has received nothing for kStallBeforeResend sends again what left
+  // long enough ago, and opens a new window.
   // A first request never sends again: the requester may have matched after
   // the slices left, and then the history is on its way to it.
   auto [entry, first] = expected_until_.try_emplace(requester);
@@ -56,13 +57,13 @@ size_t MapSender::request(const std::string& requester, uint64_t version, const 
   for (int k : wanted) {
     const auto left = leaves_at_.find(k);
     if (left != leaves_at_.end()) {
-      if (first || !open || now < left->second + grace_) continue;
+      if (first || !open || stalled < kStallBeforeResend || now < left->second + grace_) continue;
       ++resent;
     }
     if (queued_.insert(k).second) queue_.push_back(k);
   }
   resends_ += resent;
-  if (open) {
+  if (first || resent) {
     // Everything queued leaves first; then a late reader gets the history of
     // what it asked for; losses are repaired after that (kRepairSlack).
     size_t bytes = 0;

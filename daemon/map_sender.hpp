@@ -40,11 +40,12 @@ class MapSender {
   uint64_t version() const { return offer_.announcement.version(); }
 
   /// Peer `requester` asked for `slices` (every announced slice when empty) of
-  /// `version`. Queues those never written, and those written whose copy is
-  /// overdue at the requester; returns how many of them this map has (0 for
-  /// another version: the announcement tells them).
+  /// `version`, having received nothing of it for `stalled`. Queues those
+  /// never written, and those written whose copy is overdue at the requester;
+  /// returns how many of them this map has (0 for another version: the
+  /// announcement tells them).
   size_t request(const std::string& requester, uint64_t version, const std::vector<int32_t>& slices,
-                 Clock::time_point now);
+                 Clock::duration stalled, Clock::time_point now);
 
   /// Whether to start sending what is queued: once every live peer's reader
   /// has matched the writer (a reader that matches later gets the slices
@@ -72,6 +73,10 @@ class MapSender {
   /// succeeds in one round one time in three; ten rounds fail for 1.5 %).
   static constexpr double kRepairSlack = 1.5;
   static constexpr double kRepairRounds = 10;
+  /// A requester that received something within this time is being repaired
+  /// by RTPS (a reader delivers in order: one gap holds back what follows).
+  static constexpr Clock::duration kStallBeforeResend =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kRepairRounds * transport::kSliceHeartbeatS));
   /// Share of the stream's rate kept free of new samples, for RTPS repairs
   /// and for the history a late reader gets: the flow controller serves those
   /// only when no new sample waits, and a reader delivers in order, so a

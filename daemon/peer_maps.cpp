@@ -1,5 +1,8 @@
 #include "peer_maps.hpp"
 
+#include <algorithm>
+#include <climits>
+
 #include "core/text.hpp"
 #include "results/agreed_transform.hpp"
 
@@ -11,11 +14,14 @@ constexpr int kMaxBackoffDoublings = 4;  ///< requests back off to 16 x request_
 
 }  // namespace
 
-wire::ChunkRequest PeerMaps::requestFor(const std::string& owner, const Peer& p, bool everything) const {
+wire::ChunkRequest PeerMaps::requestFor(const std::string& owner, const Peer& p, bool everything,
+                                        Clock::time_point now) const {
   wire::ChunkRequest r;
   r.requester(me_);
   r.owner(owner);
   r.version(p.incoming->announcement().version());
+  const auto quiet = std::chrono::duration_cast<std::chrono::milliseconds>(now - p.last_progress).count();
+  r.stalled_ms(static_cast<uint32_t>(std::clamp<int64_t>(quiet, 0, UINT32_MAX)));
   if (!everything) r.slices(p.incoming->missing());  // else an empty list: everything
   return r;
 }
@@ -41,7 +47,7 @@ PeerMaps::Announced PeerMaps::announce(wire::MapAnnouncement a, Clock::time_poin
     complete(owner, p);
     out.complete = true;
   } else {
-    out.request = requestFor(owner, p, /*everything=*/p.reused == 0);
+    out.request = requestFor(owner, p, /*everything=*/p.reused == 0, now);
   }
   return out;
 }
@@ -84,7 +90,7 @@ std::vector<wire::ChunkRequest> PeerMaps::due(Clock::duration interval, bool at_
     if (!p.incoming || p.features) continue;
     const auto quiet_since = std::max(p.last_progress, p.last_request);
     if (!at_once && now - quiet_since < interval * (1 << std::min(p.unanswered, kMaxBackoffDoublings))) continue;
-    out.push_back(requestFor(id, p, /*everything=*/false));
+    out.push_back(requestFor(id, p, /*everything=*/false, now));
     p.last_request = now;
     ++p.unanswered;
     log_.info("asked " + id + " again for " + std::to_string(out.back().slices().size()) + " missing slices");

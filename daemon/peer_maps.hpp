@@ -89,7 +89,7 @@ class PeerMaps {
   };
   /// Builds a peer's map once every slice is in, and records the transfer.
   void complete(const std::string& owner, Peer& p);
-  wire::ChunkRequest requestFor(const std::string& owner, const Peer& p, bool everything) const;
+  wire::ChunkRequest requestFor(const std::string& owner, const Peer& p, bool everything, Clock::time_point now) const;
   /// Transfer rate so far [kbit/s]: bytes over the flow-control periods they
   /// took (the first period's budget leaves at once, so the time from the first
   /// to the last sample is one period short).

@@ -59,13 +59,14 @@ struct TopicQos {
   int depth = 1;
   int max_samples = 1024;
   int max_instances = 1024;
+  bool best_effort = false;
 };
 
 /// What writer and reader of a topic agree on: reliable, durability, history
 /// and its limits, and samples allocated at their real size (not the IDL bound).
 template <typename EndpointQos>
 EndpointQos endpointQos(EndpointQos q, const TopicQos& t) {
-  q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  q.reliability().kind = t.best_effort ? BEST_EFFORT_RELIABILITY_QOS : RELIABLE_RELIABILITY_QOS;
   q.durability().kind = t.transient_local ? TRANSIENT_LOCAL_DURABILITY_QOS : VOLATILE_DURABILITY_QOS;
   q.history().kind = t.keep_all ? KEEP_ALL_HISTORY_QOS : KEEP_LAST_HISTORY_QOS;
   q.history().depth = t.depth;
@@ -148,8 +149,10 @@ Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<
           if (on) on(std::move(s), bytes);
         },
         /*flow_controlled=*/true);
+    // Requests: best effort, since a receiver repeats them while it lacks
+    // something, and a reliable one delivered after a dropout was stale.
     i.requests = i.addTopic<wire::ChunkRequestPubSubType, wire::ChunkRequest>("tomomap/requests",
-                                                                              {false, true, 1, 256, 1}, h.request);
+                                                                              {false, true, 1, 256, 1, true}, h.request);
     i.claims =
         i.addTopic<wire::MatchClaimPubSubType, wire::MatchClaim>("tomomap/claims", {false, false, 1, 0, 1024}, h.claim);
     i.estimates = i.addTopic<wire::TransformEstimatePubSubType, wire::TransformEstimate>(

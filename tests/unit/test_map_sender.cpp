@@ -50,14 +50,16 @@ struct Wire {
 };
 
 const Clock::time_point t0{};
+/// Requests in these tests come from a requester that has heard nothing for long.
+constexpr Clock::duration kStalled = std::chrono::seconds(60);
 
 }  // namespace
 
 TEST(MapSender, SendsWhatWasAskedForOnceInOrder) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(3, 2, 9));
-  EXPECT_EQ(m.request("bravo", 9, {2, 0}, t0), 2u);
-  EXPECT_EQ(m.request("bravo", 9, {0}, t0), 1u) << "asked twice before it left: queued once";
+  EXPECT_EQ(m.request("bravo", 9, {2, 0}, kStalled, t0), 2u);
+  EXPECT_EQ(m.request("bravo", 9, {0}, kStalled, t0), 1u) << "asked twice before it left: queued once";
   EXPECT_EQ(m.queued(), 2u);
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
@@ -70,7 +72,7 @@ TEST(MapSender, SendsWhatWasAskedForOnceInOrder) {
 TEST(MapSender, ASliceStillOnItsWayIsNotSentAgain) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(2, 1, 9));
-  m.request("bravo", 9, {}, t0);  // everything
+  m.request("bravo", 9, {}, kStalled, t0);  // everything
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
   ASSERT_EQ(w.sent.size(), 2u);
@@ -78,16 +80,16 @@ TEST(MapSender, ASliceStillOnItsWayIsNotSentAgain) {
   // leave (0.24 s) with repair slack (x 1.5), ten repair rounds (10 s) and
   // 1 s of grace: a request before 11.35 s crossed them, a later one means
   // slice 1 was lost.
-  m.request("bravo", 9, {1}, t0 + 11s);
+  m.request("bravo", 9, {1}, kStalled, t0 + 11s);
   EXPECT_EQ(m.queued(), 0u);
-  m.request("bravo", 9, {1}, t0 + 11400ms);
+  m.request("bravo", 9, {1}, kStalled, t0 + 11400ms);
   EXPECT_EQ(m.queued(), 1u);
 }
 
 TEST(MapSender, AFullWriterHoldsTheRestForTheNextCall) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(2, 2, 9));
-  m.request("bravo", 9, {}, t0);
+  m.request("bravo", 9, {}, kStalled, t0);
   Wire w;
   w.room = 3;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
@@ -102,29 +104,29 @@ TEST(MapSender, AFullWriterHoldsTheRestForTheNextCall) {
 TEST(MapSender, ANewVersionDropsTheOldQueueAndOldRequests) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(3, 1, 9));
-  m.request("bravo", 9, {}, t0);
+  m.request("bravo", 9, {}, kStalled, t0);
   m.setOffer(fakeOffer(3, 1, 10));
   EXPECT_EQ(m.queued(), 0u);
-  EXPECT_EQ(m.request("bravo", 9, {0, 1}, t0), 0u) << "a request for the old version";
-  EXPECT_EQ(m.request("bravo", 10, {0, 7}, t0), 1u) << "slice 7 does not exist";
+  EXPECT_EQ(m.request("bravo", 9, {0, 1}, kStalled, t0), 0u) << "a request for the old version";
+  EXPECT_EQ(m.request("bravo", 10, {0, 7}, kStalled, t0), 1u) << "slice 7 does not exist";
   EXPECT_EQ(m.queued(), 1u);
 }
 
 TEST(MapSender, ALateReaderGetsTheHistoryInsteadOfAResend) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(4, 1, 9));
-  m.request("bravo", 9, {}, t0);
+  m.request("bravo", 9, {}, kStalled, t0);
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
   ASSERT_EQ(w.sent.size(), 4u);  // leave at 0.12 ... 0.47 s
   // charlie matched after they left and asks for everything at 2 s: the
   // history reaches it at the stream's rate (0.47 s) with repair slack
   // (x 1.5), ten repair rounds and the grace: by 13.7 s.
-  m.request("charlie", 9, {}, t0 + 2s);
+  m.request("charlie", 9, {}, kStalled, t0 + 2s);
   EXPECT_EQ(m.queued(), 0u) << "the durable history is on its way to charlie";
-  m.request("charlie", 9, {3}, t0 + 13s);
+  m.request("charlie", 9, {3}, kStalled, t0 + 13s);
   EXPECT_EQ(m.queued(), 0u) << "still within charlie's window";
-  m.request("charlie", 9, {3}, t0 + 13800ms);
+  m.request("charlie", 9, {3}, kStalled, t0 + 13800ms);
   EXPECT_EQ(m.queued(), 1u) << "overdue: lost at charlie, sent again";
   EXPECT_EQ(m.resends(), 1u);
 }
@@ -132,15 +134,15 @@ TEST(MapSender, ALateReaderGetsTheHistoryInsteadOfAResend) {
 TEST(MapSender, AStalledReaderIsAnsweredOnceItsCopyIsOverdue) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(2, 1, 9));
-  m.request("bravo", 9, {}, t0);  // window: 0.24 s x 1.5 + 10 s of repair rounds + 1 s of grace
+  m.request("bravo", 9, {}, kStalled, t0);  // window: 0.24 s x 1.5 + 10 s of repair rounds + 1 s of grace
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
-  m.request("bravo", 9, {0}, t0 + 5s);
+  m.request("bravo", 9, {0}, kStalled, t0 + 5s);
   EXPECT_EQ(m.queued(), 0u) << "slice 0 left at 0.12 s: RTPS is still repairing it";
-  m.request("bravo", 9, {0}, t0 + 11400ms);
+  m.request("bravo", 9, {0}, kStalled, t0 + 11400ms);
   EXPECT_EQ(m.queued(), 1u);
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 11400ms);
-  m.request("bravo", 9, {0}, t0 + 11500ms);
+  m.request("bravo", 9, {0}, kStalled, t0 + 11500ms);
   EXPECT_EQ(m.queued(), 0u) << "the resend is on its way";
 }
 
@@ -148,7 +150,7 @@ TEST(MapSender, StartsOnceEveryLivePeerHasMatchedOrAfterAWait) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(2, 1, 9));
   EXPECT_FALSE(m.mayStart(2, 2, t0)) << "nothing queued";
-  m.request("bravo", 9, {}, t0);
+  m.request("bravo", 9, {}, kStalled, t0);
   EXPECT_FALSE(m.mayStart(1, 2, t0)) << "charlie is up but its reader has not matched yet";
   EXPECT_TRUE(m.mayStart(2, 2, t0 + 1s));
   EXPECT_TRUE(m.mayStart(1, 2, t0 + 6s)) << "a reader that never matches does not hold the others back";
@@ -157,11 +159,23 @@ TEST(MapSender, StartsOnceEveryLivePeerHasMatchedOrAfterAWait) {
 TEST(MapSender, FeedsTheWriterAtTheStreamRateLeavingRoomForRepairs) {
   MapSender m(80, 1s);
   m.setOffer(fakeOffer(20, 1, 9));
-  m.request("bravo", 9, {}, t0);
+  m.request("bravo", 9, {}, kStalled, t0);
   Wire w;
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
   // 0.12 s a sample, at most 0.5 s ahead: five samples now, not twenty.
   EXPECT_EQ(w.sent.size(), 5u);
   m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 1s);
   EXPECT_EQ(w.sent.size(), 10u) << "the first five have left by 1 s: five more, 0.5 s ahead again";
+}
+
+TEST(MapSender, ARequesterThatIsStillReceivingIsLeftToTheRepairs) {
+  MapSender m(80, 1s);
+  m.setOffer(fakeOffer(2, 1, 9));
+  m.request("bravo", 9, {}, kStalled, t0);
+  Wire w;
+  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  m.request("bravo", 9, {0}, 3s, t0 + 20s);
+  EXPECT_EQ(m.queued(), 0u) << "bravo received something 3 s ago: RTPS holds what follows a gap";
+  m.request("bravo", 9, {0}, 15s, t0 + 20s);
+  EXPECT_EQ(m.queued(), 1u);
 }
