@@ -1,7 +1,7 @@
 #pragma once
 // A DDS participant that talks only to the peers named in the config: UDPv4
 // unicast on explicit ports, multicast and shared memory off, and a flow
-// controller that holds the configured bandwidth budget (FASTDDS-NOTES.md).
+// controller that holds the configured bandwidth budget (docs/protocol.md).
 #include <cstdint>
 #include <string>
 #include <vector>

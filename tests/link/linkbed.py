@@ -234,6 +234,9 @@ def main():
     p.add_argument("--json", help="write the report here")
     p.add_argument("--max-wire-ratio", type=float,
                    help="fail if an agent's wire bytes exceed this x payload x receivers / (1 - loss)")
+    p.add_argument("--max-written-ratio", type=float,
+                   help="fail if an agent's daemon wrote more than this x its payload (its map sent again, in part "
+                        "or whole, by the application rather than repaired by RTPS)")
     p.add_argument("--max-peak-ratio", type=float, help="fail if an agent's peak 5 s egress exceeds this x budget")
     p.add_argument("--keep", help="keep configs, logs and state in this folder")
     args = p.parse_args()
@@ -333,6 +336,9 @@ def main():
         if wire_bound and r["wire_per_payload_per_receiver"] > wire_bound:
             failures.append(f"{a}: {r['wire_per_payload_per_receiver']:.2f} x payload x receivers on the wire "
                             f"(bound {wire_bound:.2f})")
+        written = r["daemon_sent_bytes"] / max(1, r["payload_bytes"])
+        if args.max_written_ratio and written > args.max_written_ratio:
+            failures.append(f"{a}: the daemon wrote {written:.2f} x its payload (bound {args.max_written_ratio})")
         if args.max_peak_ratio and r["peak_5s_kbit"] > args.max_peak_ratio * args.budget_kbps:
             failures.append(f"{a}: peak {r['peak_5s_kbit']:.0f} kbit/s over {WINDOW_S} s "
                             f"(bound {args.max_peak_ratio} x {args.budget_kbps})")
