@@ -159,8 +159,8 @@ void Agent::onPeer(const std::string& name, bool alive) {
     if (peers_.setAlive(id, true)) log_.info("peer " + id + " is up");
     requestMissing(/*at_once=*/true);  // a request sent before it could hear us was lost
     // Durability is meant to give it our announcement, but Fast DDS misses a
-    // late reader now and then (eProsima/Fast-DDS#3822).
-    bus_->publish(sender_.offer().announcement);
+    // late reader now and then (eProsima/Fast-DDS#3822): announce again soon.
+    reannounce_ = true;
     // A late joiner gets what this agent computed, in case durability missed it.
     for (const auto& [key, t] : board_.results())
       if (t.computed_by == config_.agent()) bus_->publish(transport::toWire(t));

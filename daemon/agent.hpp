@@ -120,6 +120,7 @@ class Agent {
   MatchWorker worker_;
   Counters counters_;
   Clock::time_point last_status_{};
+  bool reannounce_ = false;  ///< a peer appeared: announce again (tick, once for peers that come together)
   Clock::time_point started_ = Clock::now();
 };
 

@@ -13,6 +13,7 @@ namespace {
 
 constexpr auto kTick = std::chrono::milliseconds(50);
 constexpr auto kReannounce = std::chrono::seconds(30);
+constexpr auto kReannounceAfterPeer = std::chrono::seconds(3);
 constexpr auto kStatusEvery = std::chrono::seconds(1);
 /// A map file must be quiet this long before it is read: writers that open,
 /// write and close it several times are done by then.
@@ -124,7 +125,11 @@ void Agent::tick(Clock::time_point& last_announce) {
                  now);
   requestMissing();
   claimAndCompute();
-  if (now - last_announce > kReannounce) {  // repairs a lost or missed announcement
+  // Repairs a lost or missed announcement. After a peer appeared, once, a
+  // little later: peers that appear together get one announcement, since each
+  // reaches every receiver.
+  if (now - last_announce > kReannounce || (reannounce_ && now - last_announce > kReannounceAfterPeer)) {
+    reannounce_ = false;
     bus_->publish(sender_.offer().announcement);
     last_announce = now;
   }
