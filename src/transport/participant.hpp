@@ -34,13 +34,15 @@ struct TransportConfig {
 constexpr int kFlowPeriodMs = 100;
 
 /// Share of the budget left to control traffic (discovery, heartbeats,
-/// acknowledgements, requests, claims, estimates), which does not pass the
-/// flow controller: the slice data gets the rest.
-constexpr double kControlShare = 0.1;
+/// acknowledgements, requests, claims, estimates, announcements), which does
+/// not pass the flow controller: the slice data gets the rest. It grows with
+/// the receivers: each new peer costs a burst of discovery and announcements
+/// (about 20 kB in the first seconds, measured) on top of a steady few kbit/s.
+double controlShare(const TransportConfig& c);
 
 /// The budget is total egress, and every slice sample goes to every receiver
 /// (one unicast datagram each), so the slice stream itself may use
-/// (1 - kControlShare) / receivers of it [kbit/s]. Receivers are the
+/// (1 - controlShare) / receivers of it [kbit/s]. Receivers are the
 /// configured peers (at least one).
 double streamKbps(const TransportConfig& c);
 
