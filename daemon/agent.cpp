@@ -79,7 +79,7 @@ bool Agent::fromKnown(const std::string& sender, const char* what) {
 
 void Agent::reject(const std::string& from, const transport::Rejection& why) {
   ++counters_.rejected;
-  log_.warning("rejected a sample from " + from + ": " + why.text());
+  if (auto line = rejections_.note(from, why.text(), Clock::now())) log_.warning(*line);
 }
 
 std::shared_ptr<const MapFeatures> Agent::featuresOf(const std::string& agent) const {

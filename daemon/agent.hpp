@@ -20,6 +20,7 @@
 #include "match_worker.hpp"
 #include "notify.hpp"
 #include "pair_board.hpp"
+#include "rejection_log.hpp"
 #include "peer_maps.hpp"
 #include "transport/bus.hpp"
 
@@ -120,6 +121,7 @@ class Agent {
   MatchWorker worker_;
   Counters counters_;
   Clock::time_point last_status_{};
+  RejectionLog rejections_;  ///< warnings for rejected samples, bounded per sender
   bool reannounce_ = false;  ///< a peer appeared: announce again (tick, once for peers that come together)
   Clock::time_point started_ = Clock::now();
 };

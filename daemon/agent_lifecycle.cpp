@@ -125,6 +125,7 @@ void Agent::tick(Clock::time_point& last_announce) {
                  now);
   requestMissing();
   claimAndCompute();
+  for (const auto& line : rejections_.due(now)) log_.warning(line);
   // Repairs a lost or missed announcement. After a peer appeared, once, a
   // little later: peers that appear together get one announcement, since each
   // reaches every receiver.
