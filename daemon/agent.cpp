@@ -10,7 +10,7 @@ Agent::Agent(Config config, Log& log)
     : config_(std::move(config)),
       log_(log),
       sender_(transport::streamKbps(config_.transport), fromSeconds(config_.request_interval_s)),
-      peers_(config_.agent(), log),
+      peers_(config_.agent(), log, peerMemoryBytes(config_)),
       board_(config_.agent(), boardTimings(config_)),
       worker_([this] { queue_cv_.notify_one(); }) {}
 
@@ -90,6 +90,7 @@ void Agent::onAnnouncement(wire::MapAnnouncement&& a) {
   const std::string owner = a.agent().to_string();
   if (owner == config_.agent() || !fromKnown(owner, "an announcement")) return;
   if (const auto why = transport::validate(a)) return reject(owner, why);
+  if (const auto why = transport::fitsBudget(a, peers_.memoryBudget())) return reject(owner, why);
   const uint64_t version = a.version();
   const auto done = peers_.announce(std::move(a), Clock::now());
   if (!done.new_version) return;

@@ -92,6 +92,7 @@ void Agent::reload() {
   log_.setThreshold(config_.log_level);
   log_.info(describe(config_));
   sender_.setBudget(transport::streamKbps(config_.transport), fromSeconds(config_.request_interval_s));
+  peers_.setMemoryBudget(peerMemoryBytes(config_));
   board_.setTimings(boardTimings(config_));
   if (!sameNetwork(previous.transport, config_.transport)) {
     log_.info("network settings changed: leaving and joining again");

@@ -27,6 +27,7 @@ const std::vector<std::string> kKeys{"agent",
                                      "log_level",
                                      "claim_timeout_s",
                                      "request_interval_s",
+                                     "peer_memory_mb",
                                      "test_drop_percent",
                                      "peer.id",
                                      "peer.host",
@@ -189,6 +190,7 @@ Config loadConfig(const std::string& path) {
     r.fail(*root.get("log_level"), "log_level", "must be debug, info, warning or error");
   c.claim_timeout_s = r.number(root, "claim_timeout_s", 30, 1, 3600);
   c.request_interval_s = r.number(root, "request_interval_s", 1, 0.1, 600);
+  c.peer_memory_mb = r.number(root, "peer_memory_mb", c.peer_memory_mb, 16, 65536);
   t.test_drop_percent = r.integer(root, "test_drop_percent", t.test_drop_percent, 0, 90);
 
   if (const toml::node* peers = root.get("peer")) {
@@ -224,7 +226,8 @@ std::string describe(const Config& c) {
     << "\n  address = " << t.address << "\n  discovery_port = " << t.discovery_port << "\n  data_port = " << t.data_port
     << "\n  bandwidth_kbps = " << t.bandwidth_kbps << "\n  output_dir = " << c.output_dir
     << "\n  log_level = " << levels[static_cast<int>(c.log_level)] << "\n  claim_timeout_s = " << c.claim_timeout_s
-    << "\n  request_interval_s = " << c.request_interval_s << "\n  test_drop_percent = " << t.test_drop_percent
+    << "\n  request_interval_s = " << c.request_interval_s << "\n  peer_memory_mb = " << c.peer_memory_mb
+    << "\n  test_drop_percent = " << t.test_drop_percent
     << "\n  match.max_features = " << m.features.max_features
     << "\n  match.fast_threshold = " << m.features.fast_threshold
     << "\n  match.ransac_threshold_cells = " << m.ransac_threshold_cells

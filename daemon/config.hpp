@@ -19,10 +19,14 @@ struct Config {
   LogLevel log_level = LogLevel::Info;
   double claim_timeout_s = 30;    ///< a claim without a result is void after this [s]
   double request_interval_s = 1;  ///< ask again for missing slices after this much silence [s]
+  double peer_memory_mb = 256;    ///< memory one peer's map may take here, checked before it is allocated [MB]
 
   const std::string& agent() const { return transport.agent; }
   bool isPeer(const std::string& id) const;
 };
+
+/// peer_memory_mb in bytes.
+inline size_t peerMemoryBytes(const Config& c) { return static_cast<size_t>(c.peer_memory_mb * 1e6); }
 
 /// Every key the parser knows, for the reference-docs test.
 const std::vector<std::string>& configKeys();

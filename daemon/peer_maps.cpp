@@ -32,7 +32,7 @@ PeerMaps::Announced PeerMaps::announce(wire::MapAnnouncement a, Clock::time_poin
   if (p.incoming && p.incoming->announcement().version() == a.version()) return {};  // already known
   std::optional<transport::Reassembler> earlier = std::move(p.incoming);
   p = Peer{};
-  p.incoming.emplace(std::move(a));
+  p.incoming.emplace(std::move(a), memory_budget_);
   // A new version of a map we hold (or held in part): keep the unchanged slices.
   if (earlier) p.reused = p.incoming->adopt(*earlier);
   const auto& announced = p.incoming->announcement();
@@ -87,7 +87,7 @@ void PeerMaps::complete(const std::string& owner, Peer& p) {
 std::vector<wire::ChunkRequest> PeerMaps::due(Clock::duration interval, bool at_once, Clock::time_point now) {
   std::vector<wire::ChunkRequest> out;
   for (auto& [id, p] : peers_) {
-    if (!p.incoming || p.features) continue;
+    if (!p.incoming || p.features || p.incoming->refused()) continue;
     const auto quiet_since = std::max(p.last_progress, p.last_request);
     if (!at_once && now - quiet_since < interval * (1 << std::min(p.unanswered, kMaxBackoffDoublings))) continue;
     out.push_back(requestFor(id, p, /*everything=*/false, now));

@@ -19,7 +19,11 @@ namespace tomomap::daemon {
 
 class PeerMaps {
  public:
-  PeerMaps(std::string me, const Log& log) : me_(std::move(me)), log_(log) {}
+  /// `memory_budget`: bytes one peer's map may take (peer_memory_mb).
+  PeerMaps(std::string me, const Log& log, size_t memory_budget)
+      : me_(std::move(me)), log_(log), memory_budget_(memory_budget) {}
+  void setMemoryBudget(size_t bytes) { memory_budget_ = bytes; }
+  size_t memoryBudget() const { return memory_budget_; }
 
   /// What a new announcement led to.
   struct Announced {
@@ -97,6 +101,7 @@ class PeerMaps {
 
   std::string me_;
   const Log& log_;
+  size_t memory_budget_;
   std::map<std::string, Peer> peers_;
   std::map<std::string, std::deque<Transfer>> transfers_;  ///< finished transfers per peer, latest last
   std::set<std::string> alive_;

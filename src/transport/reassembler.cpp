@@ -7,11 +7,23 @@
 
 namespace tomomap::transport {
 
-Reassembler::Reassembler(wire::MapAnnouncement announcement) : announcement_(std::move(announcement)) {
+size_t announcedMemory(const wire::MapAnnouncement& a) {
+  size_t bytes = static_cast<size_t>(a.width()) * a.height();  // the image ORB runs on
+  for (const auto& e : a.slices()) bytes += e.bytes();
+  return bytes;
+}
+
+Rejection fitsBudget(const wire::MapAnnouncement& a, size_t budget) {
+  return announcedMemory(a) > budget ? Rejection{Reject::OverBudget} : Rejection{};
+}
+
+Reassembler::Reassembler(wire::MapAnnouncement announcement, size_t memory_budget)
+    : announcement_(std::move(announcement)), budget_(memory_budget) {
   for (size_t i = 0; i < announcement_.slices().size(); ++i) entries_[announcement_.slices()[i].slice()] = i;
 }
 
 Rejection Reassembler::accept(const wire::SliceFeatures& x) {
+  if (refused_) return {Reject::OverBudget, x.slice()};
   const auto it = entries_.find(x.slice());
   if (it == entries_.end()) return {Reject::NotAnnounced, x.slice()};
   const wire::SliceEntry& e = announcement_.slices()[it->second];
@@ -45,8 +57,20 @@ Rejection Reassembler::accept(const wire::SliceFeatures& x) {
   const auto canonical = canonicalBytes(parts);
   if (canonical.size() != e.bytes() || crcOf(canonical) != e.crc32()) return {Reject::ChecksumMismatch, x.slice()};
   if (parts.front().encoding() == wire::SliceEncoding::OCCUPANCY) {
-    auto decoded = inflateCells(canonical, announcement_.width(), announcement_.height());
+    const size_t taken = announcedMemory(announcement_) + cell_bytes_;
+    const size_t room = budget_ > taken ? (budget_ - taken) / sizeof(uint32_t) : 0;
+    bool too_many = false;
+    auto decoded = inflateCells(canonical, announcement_.width(), announcement_.height(), room, &too_many);
+    if (too_many) {
+      refused_ = true;
+      partial_.clear();
+      done_.clear();
+      cells_.clear();
+      cell_bytes_ = 0;
+      return {Reject::OverBudget, x.slice()};
+    }
     if (!decoded) return {Reject::NotInflating, x.slice()};
+    cell_bytes_ += decoded->size() * sizeof(uint32_t);
     cells_[x.slice()] = std::move(*decoded);
   }
   done_[x.slice()] = std::move(parts);
@@ -76,7 +100,10 @@ size_t Reassembler::adopt(const Reassembler& earlier) {
     const wire::SliceEntry& then = b.slices()[old->second];
     if (now.crc32() != then.crc32() || now.bytes() != then.bytes() || now.parts() != then.parts()) continue;
     done_[index] = parts->second;
-    if (const auto cells = earlier.cells_.find(index); cells != earlier.cells_.end()) cells_[index] = cells->second;
+    if (const auto cells = earlier.cells_.find(index); cells != earlier.cells_.end()) {
+      cells_[index] = cells->second;
+      cell_bytes_ += cells->second.size() * sizeof(uint32_t);
+    }
     partial_.erase(index);
     ++taken;
   }

@@ -36,6 +36,8 @@ std::string Rejection::text() const {
       return "slice checksum mismatch";
     case Reject::NotInflating:
       return "occupancy does not inflate to the announced raster";
+    case Reject::OverBudget:
+      return "the map would take more memory than peer_memory_mb allows";
     case Reject::UnorderedPair:
       return "estimate with an unordered pair";
     case Reject::NonFiniteTransform:

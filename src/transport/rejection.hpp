@@ -23,6 +23,7 @@ enum class Reject {
   LargerThanAnnounced,
   ChecksumMismatch,
   NotInflating,   ///< occupancy that does not inflate to the announced raster
+  OverBudget,     ///< a peer's map that would take more memory than peer_memory_mb
   UnorderedPair,  ///< estimate whose target id is not below its source id
   NonFiniteTransform,
 };

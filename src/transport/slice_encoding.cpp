@@ -28,12 +28,21 @@ std::vector<uint8_t> deflateCells(const std::vector<uint32_t>& cells, int width,
   return out;
 }
 
-std::optional<std::vector<uint32_t>> inflateCells(const std::vector<uint8_t>& bytes, int width, int height) {
+std::optional<std::vector<uint32_t>> inflateCells(const std::vector<uint8_t>& bytes, int width, int height,
+                                                  size_t max_cells, bool* too_many) {
+  if (too_many) *too_many = false;
   std::vector<uint8_t> raster(rasterBytes(static_cast<size_t>(width), static_cast<size_t>(height)));
   uLongf size = static_cast<uLongf>(raster.size());
   if (uncompress(raster.data(), &size, bytes.data(), static_cast<uLong>(bytes.size())) != Z_OK || size != raster.size())
     return std::nullopt;
+  size_t set = 0;
+  for (uint8_t b : raster) set += static_cast<size_t>(__builtin_popcount(b));
+  if (set > max_cells) {
+    if (too_many) *too_many = true;
+    return std::nullopt;
+  }
   std::vector<uint32_t> cells;
+  cells.reserve(set);
   const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
   for (size_t i = 0; i < raster.size(); ++i)
     for (uint32_t bit = 0; raster[i] >> bit; ++bit)

@@ -20,8 +20,11 @@ size_t rasterBytes(size_t width, size_t height);
 /// take 4 each. Empty on a zlib failure.
 std::vector<uint8_t> deflateCells(const std::vector<uint32_t>& cells, int width, int height);
 
-/// The inverse; nullopt when the bytes do not inflate to exactly the raster.
-std::optional<std::vector<uint32_t>> inflateCells(const std::vector<uint8_t>& bytes, int width, int height);
+/// The inverse; nullopt when the bytes do not inflate to exactly the raster,
+/// or when the raster holds more than `max_cells` set cells (checked before
+/// the cell list is allocated: `*too_many` tells which).
+std::optional<std::vector<uint32_t>> inflateCells(const std::vector<uint8_t>& bytes, int width, int height,
+                                                  size_t max_cells = SIZE_MAX, bool* too_many = nullptr);
 
 /// A slice's keypoints as pixels of `grid` with their descriptors. Keypoints
 /// sit on pixel centres (single-level ORB), so the round trip is exact.

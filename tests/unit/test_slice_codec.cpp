@@ -195,3 +195,27 @@ TEST(SliceCodec, TheReceiverRunsOrbWithTheAnnouncedSettings) {
   const MapOffer usual = makeOffer("alpha", sampleMap(), {}, 1000000, 4000);
   EXPECT_NE(usual.announcement.version(), offer.announcement.version());
 }
+
+TEST(SliceCodec, AMapOverTheMemoryBudgetIsRefusedBeforeAndWhileItArrives) {
+  const MapOffer offer = makeOffer("alpha", sampleMap(), {}, 1000000, 4000);
+  const size_t needs = announcedMemory(offer.announcement);
+  EXPECT_EQ(fitsBudget(offer.announcement, needs - 1), Reject::OverBudget) << "refused before anything is allocated";
+  EXPECT_FALSE(fitsBudget(offer.announcement, needs));
+
+  // Fits as announced, but its occupancy inflates to more cells than the
+  // rest of the budget holds: the map is refused as that slice completes.
+  Reassembler r(offer.announcement, needs + 16);
+  Rejection last;
+  for (const auto& [k, samples] : offer.samples)
+    for (const auto& s : samples)
+      if (const auto why = r.accept(s)) last = why;
+  EXPECT_EQ(last, Reject::OverBudget);
+  EXPECT_TRUE(r.refused());
+  EXPECT_FALSE(r.complete());
+  EXPECT_EQ(r.accept(offer.samples.begin()->second.front()), Reject::OverBudget) << "every later sample too";
+
+  Reassembler roomy(offer.announcement, needs * 100);
+  for (const auto& [k, samples] : offer.samples)
+    for (const auto& s : samples) EXPECT_FALSE(roomy.accept(s));
+  EXPECT_TRUE(roomy.complete()) << "the same map within a budget that holds it";
+}
