@@ -190,7 +190,7 @@ Config loadConfig(const std::string& path) {
     r.fail(*root.get("log_level"), "log_level", "must be debug, info, warning or error");
   c.claim_timeout_s = r.number(root, "claim_timeout_s", 30, 1, 3600);
   c.request_interval_s = r.number(root, "request_interval_s", 1, 0.1, 600);
-  c.peer_memory_mb = r.number(root, "peer_memory_mb", c.peer_memory_mb, 16, 65536);
+  c.peer_memory_mb = r.number(root, "peer_memory_mb", c.peer_memory_mb, 1, 65536);
   t.test_drop_percent = r.integer(root, "test_drop_percent", t.test_drop_percent, 0, 90);
 
   if (const toml::node* peers = root.get("peer")) {

@@ -23,6 +23,7 @@ struct AgentSpec {
   double grid = 0.05;
   double bandwidth_kbps = 10000;
   std::vector<std::string> peers;  ///< ids it lists; all of the fleet's others by default
+  std::string extra;               ///< more config lines ("key = value\n")
 
   AgentSpec(std::string id_, std::string map_, double grid_ = 0.05, double kbps = 10000,
             std::vector<std::string> peers_ = {})
@@ -52,7 +53,7 @@ class Fleet {
     c << "agent = \"" << spec.id << "\"\nmap = \"" << spec.map << "\"\ngrid = " << spec.grid
       << "\ndiscovery_port = " << port(indexOf(spec.id, everyone)) << "\nbandwidth_kbps = " << spec.bandwidth_kbps
       << "\noutput_dir = \"" << (dir_ / ("out-" + spec.id)) << "\"\nrequest_interval_s = 1\nclaim_timeout_s = " << claim_timeout_s
-      << "\n";
+      << "\n" << spec.extra;
     for (const auto& other : everyone) {
       if (other.id == spec.id) continue;
       if (!spec.peers.empty() && std::find(spec.peers.begin(), spec.peers.end(), other.id) == spec.peers.end())

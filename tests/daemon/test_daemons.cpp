@@ -145,6 +145,33 @@ TEST(Daemons, SamplesFromAnAgentNotInTheConfigAreDroppedAndCounted) {
   stopAll(fleet, {"alpha", "bravo", "mallory"});
 }
 
+TEST(Daemons, APeerMapOverTheMemoryBudgetIsRefusedAndTheDaemonStaysResponsive) {
+  TempDir dir;
+  // Each map fits its announcement into 1 MB but inflates to about a million
+  // occupied cells (4 MB): alpha, allowed 1 MB per peer, refuses bravo's map
+  // as it arrives; bravo, with the default, takes alpha's.
+  const auto gen = runTomomap("synth -o " + (dir / "world") + " -n 2 --noise low -s 4");
+  ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  Fleet fleet(dir);
+  std::vector<AgentSpec> agents{{"alpha", dir / "world/map_0.pcd"}, {"bravo", dir / "world/map_1.pcd"}};
+  agents[0].extra = "peer_memory_mb = 1\n";
+  for (const auto& a : agents) fleet.start(a, agents);
+  EXPECT_TRUE(Fleet::waitFor(
+      [&] { return fleet.log("alpha").find("more memory than peer_memory_mb allows") != std::string::npos; }, 120s))
+      << fleet.log("alpha");
+  EXPECT_TRUE(Fleet::waitFor(
+      [&] { return fleet.readJson("alpha", "status.json").value("rejected_samples", 0) > 0; }, 30s));
+  EXPECT_TRUE(Fleet::waitFor([&] { return fleet.log("bravo").find("received the map of alpha") != std::string::npos; },
+                             120s))
+      << fleet.log("bravo");
+  const std::string log = fleet.log("alpha");
+  size_t lines = 0;
+  for (size_t at = log.find("rejected"); at != std::string::npos; at = log.find("rejected", at + 1)) ++lines;
+  EXPECT_LE(lines, 2u) << "one line, not one per sample\n" << log;
+  EXPECT_EQ(log.find("received the map of bravo"), std::string::npos) << "alpha never holds bravo's map";
+  stopAll(fleet, {"alpha", "bravo"});
+}
+
 TEST(Daemons, BadConfigNamesFileLineAndKey) {
   TempDir dir;
   std::ofstream(dir / "bad.toml") << "agent = \"alpha\"\nmap = \"x.pcd\"\ndiscovery_port = \"many\"\n";
