@@ -117,7 +117,7 @@ void Agent::onRequest(wire::ChunkRequest&& r) {
   if (!fromKnown(r.requester().to_string(), "a request")) return;
   const size_t resent = sender_.resends();
   const size_t wanted = sender_.request(r.requester().to_string(), r.version(), r.slices(),
-                                      std::chrono::milliseconds(r.stalled_ms()), Clock::now());
+                                        std::chrono::milliseconds(r.stalled_ms()), Clock::now());
   log_.debug(r.requester().to_string() + " asked for " + std::to_string(wanted) + " slices; " +
              std::to_string(sender_.queued()) + " queued, " + std::to_string(sender_.resends() - resent) +
              " of them again (their copies overdue)");

@@ -20,8 +20,8 @@
 #include "match_worker.hpp"
 #include "notify.hpp"
 #include "pair_board.hpp"
-#include "rejection_log.hpp"
 #include "peer_maps.hpp"
+#include "rejection_log.hpp"
 #include "transport/bus.hpp"
 
 namespace tomomap::daemon {

@@ -227,8 +227,7 @@ std::string describe(const Config& c) {
     << "\n  bandwidth_kbps = " << t.bandwidth_kbps << "\n  output_dir = " << c.output_dir
     << "\n  log_level = " << levels[static_cast<int>(c.log_level)] << "\n  claim_timeout_s = " << c.claim_timeout_s
     << "\n  request_interval_s = " << c.request_interval_s << "\n  peer_memory_mb = " << c.peer_memory_mb
-    << "\n  test_drop_percent = " << t.test_drop_percent
-    << "\n  match.max_features = " << m.features.max_features
+    << "\n  test_drop_percent = " << t.test_drop_percent << "\n  match.max_features = " << m.features.max_features
     << "\n  match.fast_threshold = " << m.features.fast_threshold
     << "\n  match.ransac_threshold_cells = " << m.ransac_threshold_cells
     << "\n  match.ransac_iterations = " << m.ransac_iterations

@@ -75,8 +75,8 @@ class MapSender {
   static constexpr double kRepairRounds = 10;
   /// A requester that received something within this time is being repaired
   /// by RTPS (a reader delivers in order: one gap holds back what follows).
-  static constexpr Clock::duration kStallBeforeResend =
-      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kRepairRounds * transport::kSliceHeartbeatS));
+  static constexpr Clock::duration kStallBeforeResend = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(kRepairRounds * transport::kSliceHeartbeatS));
   /// Share of the stream's rate kept free of new samples, for RTPS repairs
   /// and for the history a late reader gets: the flow controller serves those
   /// only when no new sample waits, and a reader delivers in order, so a

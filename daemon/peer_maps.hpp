@@ -82,8 +82,8 @@ class PeerMaps {
     Clock::time_point requested{};  ///< when this version was first asked for: the transfer's start
     Clock::time_point first_slice{}, last_slice{};
     size_t bytes = 0, samples = 0;
-    size_t reused = 0;  ///< slices kept from the previous version
-    int unanswered = 0; ///< requests since the last progress
+    size_t reused = 0;   ///< slices kept from the previous version
+    int unanswered = 0;  ///< requests since the last progress
   };
   /// A finished transfer of one version of a peer's map.
   struct Transfer {

@@ -10,8 +10,7 @@ std::optional<std::string> RejectionLog::note(const std::string& sender, const s
   Sender& s = it->second;
   if (first || (s.unlogged == 0 && now >= s.window_start + window_)) {
     s.window_start = now;
-    return "rejected a sample from " + sender + ": " + why + " (more from " + sender +
-           " are summarised once a minute)";
+    return "rejected a sample from " + sender + ": " + why + " (more from " + sender + " are summarised once a minute)";
   }
   ++s.unlogged;
   // Bounded: a sender's reasons are the rejection texts, a few dozen kinds.

@@ -88,7 +88,7 @@ DataWriterQos writerQos(const TopicQos& t) {
 /// payload at the smallest sample size, far above any map sent so far.
 constexpr int kSliceInstances = 1 << 16;
 
-constexpr double kNackSuppressionMs = 500;    ///< longer than a link's round trip plus a queue's wait
+constexpr double kNackSuppressionMs = 500;  ///< longer than a link's round trip plus a queue's wait
 
 }  // namespace
 
@@ -120,7 +120,8 @@ struct Bus::Impl {
       // the repair, each repeat sent the sample again (10 % loss and 50 ms
       // delay: up to 11 x the map on the wire). Repeats within this time of a
       // repair's departure are ignored.
-      wq.reliable_writer_qos().times.nackSupressionDuration = eprosima::fastrtps::Duration_t(kNackSuppressionMs / 1000.0);
+      wq.reliable_writer_qos().times.nackSupressionDuration =
+          eprosima::fastrtps::Duration_t(kNackSuppressionMs / 1000.0);
     }
     DataWriter* w = publisher->create_datawriter(topic, wq);
     if (!w) throw std::runtime_error("cannot create the writer of " + name);
@@ -151,8 +152,8 @@ Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<
         /*flow_controlled=*/true);
     // Requests: best effort, since a receiver repeats them while it lacks
     // something, and a reliable one delivered after a dropout was stale.
-    i.requests = i.addTopic<wire::ChunkRequestPubSubType, wire::ChunkRequest>("tomomap/requests",
-                                                                              {false, true, 1, 256, 1, true}, h.request);
+    i.requests = i.addTopic<wire::ChunkRequestPubSubType, wire::ChunkRequest>(
+        "tomomap/requests", {false, true, 1, 256, 1, true}, h.request);
     i.claims =
         i.addTopic<wire::MatchClaimPubSubType, wire::MatchClaim>("tomomap/claims", {false, false, 1, 0, 1024}, h.claim);
     i.estimates = i.addTopic<wire::TransformEstimatePubSubType, wire::TransformEstimate>(

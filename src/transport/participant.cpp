@@ -39,9 +39,7 @@ double streamKbps(const TransportConfig& c) {
   return (1 - controlShare(c)) * c.bandwidth_kbps / static_cast<double>(receivers(c));
 }
 
-int flowPeriodMs(const TransportConfig& c) {
-  return kFlowPeriodMs * static_cast<int>(receivers(c));
-}
+int flowPeriodMs(const TransportConfig& c) { return kFlowPeriodMs * static_cast<int>(receivers(c)); }
 
 namespace {
 

@@ -52,8 +52,9 @@ class Fleet {
     std::ostringstream c;
     c << "agent = \"" << spec.id << "\"\nmap = \"" << spec.map << "\"\ngrid = " << spec.grid
       << "\ndiscovery_port = " << port(indexOf(spec.id, everyone)) << "\nbandwidth_kbps = " << spec.bandwidth_kbps
-      << "\noutput_dir = \"" << (dir_ / ("out-" + spec.id)) << "\"\nrequest_interval_s = 1\nclaim_timeout_s = " << claim_timeout_s
-      << "\n" << spec.extra;
+      << "\noutput_dir = \"" << (dir_ / ("out-" + spec.id))
+      << "\"\nrequest_interval_s = 1\nclaim_timeout_s = " << claim_timeout_s << "\n"
+      << spec.extra;
     for (const auto& other : everyone) {
       if (other.id == spec.id) continue;
       if (!spec.peers.empty() && std::find(spec.peers.begin(), spec.peers.end(), other.id) == spec.peers.end())

@@ -159,10 +159,10 @@ TEST(Daemons, APeerMapOverTheMemoryBudgetIsRefusedAndTheDaemonStaysResponsive) {
   EXPECT_TRUE(Fleet::waitFor(
       [&] { return fleet.log("alpha").find("more memory than peer_memory_mb allows") != std::string::npos; }, 120s))
       << fleet.log("alpha");
-  EXPECT_TRUE(Fleet::waitFor(
-      [&] { return fleet.readJson("alpha", "status.json").value("rejected_samples", 0) > 0; }, 30s));
-  EXPECT_TRUE(Fleet::waitFor([&] { return fleet.log("bravo").find("received the map of alpha") != std::string::npos; },
-                             120s))
+  EXPECT_TRUE(
+      Fleet::waitFor([&] { return fleet.readJson("alpha", "status.json").value("rejected_samples", 0) > 0; }, 30s));
+  EXPECT_TRUE(
+      Fleet::waitFor([&] { return fleet.log("bravo").find("received the map of alpha") != std::string::npos; }, 120s))
       << fleet.log("bravo");
   const std::string log = fleet.log("alpha");
   size_t lines = 0;
