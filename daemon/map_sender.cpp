@@ -45,19 +45,19 @@ size_t MapSender::request(const std::string& requester, uint64_t version, const 
 
   // Within the requester's window the copies written are still on their way
   // (live, repaired, or from the history if it matched late): only slices
-  // never written are queued. A request after the window from a requester
-  // that has received nothing for kStallBeforeResend sends again what left
-  // long enough ago, and opens a new window.
-  // A first request never sends again: the requester may have matched after
-  // the slices left, and then the history is on its way to it.
+  // never written are queued. A first request never sends again (the
+  // requester may have matched after the slices left, and then the history is
+  // on its way to it). A request after the window from a requester that has
+  // received nothing for kStallBeforeResend sends again what left long enough
+  // ago, and opens a new window.
   auto [entry, first] = expected_until_.try_emplace(requester);
   Clock::time_point& until = entry->second;
-  const bool open = now >= until;
+  const bool may_resend = !first && now >= until && stalled >= kStallBeforeResend;
   size_t resent = 0;
   for (int k : wanted) {
     const auto left = leaves_at_.find(k);
     if (left != leaves_at_.end()) {
-      if (first || !open || stalled < kStallBeforeResend || now < left->second + grace_) continue;
+      if (!may_resend || now < left->second + grace_) continue;
       ++resent;
     }
     if (queued_.insert(k).second) queue_.push_back(k);
@@ -71,8 +71,7 @@ size_t MapSender::request(const std::string& requester, uint64_t version, const 
     for (int k : wanted)
       if (!queued_.count(k)) bytes += sliceBytes(k);
     until = std::max(backlog_until_, now) +
-            std::chrono::duration_cast<Clock::duration>(kRepairSlack * leaveTime(bytes)) +
-            fromSeconds(kRepairRounds * transport::kSliceHeartbeatS) + grace_;
+            std::chrono::duration_cast<Clock::duration>(kRepairSlack * leaveTime(bytes)) + kStallBeforeResend + grace_;
   }
   return wanted.size();
 }

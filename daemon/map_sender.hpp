@@ -68,13 +68,14 @@ class MapSender {
 
  private:
   /// Repairs of lost samples follow the rest: a window is this many times
-  /// the time its bytes take to leave, plus kRepairRounds heartbeat periods
-  /// (at 30 % loss of data, heartbeats and acknowledgements alike a repair
-  /// succeeds in one round one time in three; ten rounds fail for 1.5 %).
+  /// the time its bytes take to leave, plus kStallBeforeResend.
   static constexpr double kRepairSlack = 1.5;
+  /// Ten heartbeat rounds of RTPS repairs (at 30 % loss of data, heartbeats
+  /// and acknowledgements alike a repair succeeds in one round one time in
+  /// three; ten rounds fail for 1.5 %). A requester that received something
+  /// within this time is being repaired by RTPS (a reader delivers in order:
+  /// one gap holds back what follows), and a window includes it.
   static constexpr double kRepairRounds = 10;
-  /// A requester that received something within this time is being repaired
-  /// by RTPS (a reader delivers in order: one gap holds back what follows).
   static constexpr Clock::duration kStallBeforeResend = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(kRepairRounds * transport::kSliceHeartbeatS));
   /// Share of the stream's rate kept free of new samples, for RTPS repairs

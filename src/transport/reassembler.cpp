@@ -18,7 +18,9 @@ Rejection fitsBudget(const wire::MapAnnouncement& a, size_t budget) {
 }
 
 Reassembler::Reassembler(wire::MapAnnouncement announcement, size_t memory_budget)
-    : announcement_(std::move(announcement)), budget_(memory_budget) {
+    : announcement_(std::move(announcement)),
+      budget_(memory_budget),
+      announced_memory_(announcedMemory(announcement_)) {
   for (size_t i = 0; i < announcement_.slices().size(); ++i) entries_[announcement_.slices()[i].slice()] = i;
 }
 
@@ -57,7 +59,7 @@ Rejection Reassembler::accept(const wire::SliceFeatures& x) {
   const auto canonical = canonicalBytes(parts);
   if (canonical.size() != e.bytes() || crcOf(canonical) != e.crc32()) return {Reject::ChecksumMismatch, x.slice()};
   if (parts.front().encoding() == wire::SliceEncoding::OCCUPANCY) {
-    const size_t taken = announcedMemory(announcement_) + cell_bytes_;
+    const size_t taken = announced_memory_ + cell_bytes_;
     const size_t room = budget_ > taken ? (budget_ - taken) / sizeof(uint32_t) : 0;
     bool too_many = false;
     auto decoded = inflateCells(canonical, announcement_.width(), announcement_.height(), room, &too_many);

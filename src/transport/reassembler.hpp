@@ -61,7 +61,8 @@ class Reassembler {
   std::map<int, std::vector<uint32_t>> cells_;  ///< inflated occupancy of verified slices
   size_t bytes_received_ = 0;
   size_t budget_;
-  size_t cell_bytes_ = 0;  ///< held by cells_
+  size_t announced_memory_;  ///< announcedMemory(announcement_)
+  size_t cell_bytes_ = 0;    ///< held by cells_
   bool refused_ = false;
 };
 

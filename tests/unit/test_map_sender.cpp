@@ -47,6 +47,10 @@ struct Wire {
     sent.emplace_back(s.slice(), s.part());
     return true;
   }
+  /// `m` hands this wire what it would send at `at`, 1000 bytes a sample.
+  void take(MapSender& m, Clock::time_point at) {
+    m.pump([this](const wire::SliceFeatures& s) { return publish(s); }, thousand, at);
+  }
 };
 
 const Clock::time_point t0{};
@@ -62,7 +66,7 @@ TEST(MapSender, SendsWhatWasAskedForOnceInOrder) {
   EXPECT_EQ(m.request("bravo", 9, {0}, kStalled, t0), 1u) << "asked twice before it left: queued once";
   EXPECT_EQ(m.queued(), 2u);
   Wire w;
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  w.take(m, t0);
   EXPECT_EQ(w.sent, (std::vector<std::pair<int, int>>{{2, 0}, {2, 1}, {0, 0}, {0, 1}}));
   EXPECT_EQ(m.bytesSent(), 4000u);
   EXPECT_EQ(m.samplesSent(), 4u);
@@ -74,7 +78,7 @@ TEST(MapSender, ASliceStillOnItsWayIsNotSentAgain) {
   m.setOffer(fakeOffer(2, 1, 9));
   m.request("bravo", 9, {}, kStalled, t0);  // everything
   Wire w;
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  w.take(m, t0);
   ASSERT_EQ(w.sent.size(), 2u);
   // Slice 1 leaves the controller at 0.24 s. bravo's window: both slices
   // leave (0.24 s) with repair slack (x 1.5), ten repair rounds (10 s) and
@@ -92,11 +96,11 @@ TEST(MapSender, AFullWriterHoldsTheRestForTheNextCall) {
   m.request("bravo", 9, {}, kStalled, t0);
   Wire w;
   w.room = 3;
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  w.take(m, t0);
   EXPECT_EQ(w.sent.size(), 3u);
   EXPECT_EQ(m.queued(), 1u);
   w.room = 10;
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 50ms);
+  w.take(m, t0 + 50ms);
   EXPECT_EQ(w.sent.back(), std::make_pair(1, 1)) << "the slice's last part follows on";
   EXPECT_EQ(m.queued(), 0u);
 }
@@ -117,7 +121,7 @@ TEST(MapSender, ALateReaderGetsTheHistoryInsteadOfAResend) {
   m.setOffer(fakeOffer(4, 1, 9));
   m.request("bravo", 9, {}, kStalled, t0);
   Wire w;
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  w.take(m, t0);
   ASSERT_EQ(w.sent.size(), 4u);  // leave at 0.12 ... 0.47 s
   // charlie matched after they left and asks for everything at 2 s: the
   // history reaches it at the stream's rate (0.47 s) with repair slack
@@ -136,12 +140,12 @@ TEST(MapSender, AStalledReaderIsAnsweredOnceItsCopyIsOverdue) {
   m.setOffer(fakeOffer(2, 1, 9));
   m.request("bravo", 9, {}, kStalled, t0);  // window: 0.24 s x 1.5 + 10 s of repair rounds + 1 s of grace
   Wire w;
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  w.take(m, t0);
   m.request("bravo", 9, {0}, kStalled, t0 + 5s);
   EXPECT_EQ(m.queued(), 0u) << "slice 0 left at 0.12 s: RTPS is still repairing it";
   m.request("bravo", 9, {0}, kStalled, t0 + 11400ms);
   EXPECT_EQ(m.queued(), 1u);
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 11400ms);
+  w.take(m, t0 + 11400ms);
   m.request("bravo", 9, {0}, kStalled, t0 + 11500ms);
   EXPECT_EQ(m.queued(), 0u) << "the resend is on its way";
 }
@@ -161,10 +165,10 @@ TEST(MapSender, FeedsTheWriterAtTheStreamRateLeavingRoomForRepairs) {
   m.setOffer(fakeOffer(20, 1, 9));
   m.request("bravo", 9, {}, kStalled, t0);
   Wire w;
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  w.take(m, t0);
   // 0.12 s a sample, at most 0.5 s ahead: five samples now, not twenty.
   EXPECT_EQ(w.sent.size(), 5u);
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0 + 1s);
+  w.take(m, t0 + 1s);
   EXPECT_EQ(w.sent.size(), 10u) << "the first five have left by 1 s: five more, 0.5 s ahead again";
 }
 
@@ -173,7 +177,7 @@ TEST(MapSender, ARequesterThatIsStillReceivingIsLeftToTheRepairs) {
   m.setOffer(fakeOffer(2, 1, 9));
   m.request("bravo", 9, {}, kStalled, t0);
   Wire w;
-  m.pump([&](const auto& s) { return w.publish(s); }, thousand, t0);
+  w.take(m, t0);
   m.request("bravo", 9, {0}, 3s, t0 + 20s);
   EXPECT_EQ(m.queued(), 0u) << "bravo received something 3 s ago: RTPS holds what follows a gap";
   m.request("bravo", 9, {0}, 15s, t0 + 20s);
