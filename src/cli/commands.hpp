@@ -16,5 +16,6 @@ Command addSynthCommand(CLI::App& app);
 Command addEvalCommand(CLI::App& app);
 Command addVizCommand(CLI::App& app);
 Command addStatusCommand(CLI::App& app);
+Command addFleetKeysCommand(CLI::App& app);
 
 }  // namespace tomomap::cli
