@@ -31,7 +31,7 @@ OwnMap describeOwnMap(const Config& config) {
     return std::make_shared<MapFeatures>(describeMap(map, config.match, nullptr, &own.cells));
   }();
   own.offer = transport::makeOffer(config.agent(), *features, config.match.features, binaryPcdBytes(own.cells),
-                                   transport::maxSampleBytes(config.transport.bandwidth_kbps));
+                                   transport::maxSampleBytes(config.transport.bandwidth_kbps, config.transport.security.enabled()));
   own.features = std::move(features);
   own.seconds = seconds(Clock::now() - t0);
   return own;
@@ -75,6 +75,19 @@ bool Agent::fromKnown(const std::string& sender, const char* what) {
   if (!known(sender, what)) return false;
   peers_.seen(sender, wallMs());  // callers have set aside our own samples
   return true;
+}
+
+void Agent::onImpostor(const std::string& claimed, const std::string& sender) {
+  ++counters_.impostors;
+  const std::string from = sender.empty() ? "a participant that speaks for no agent" : sender;
+  if (auto line = rejections_.note(from, "a sample in the name of '" + claimed + "' (dropped)", Clock::now()))
+    log_.warning(*line);
+}
+
+void Agent::onRefused(const std::string& participant, const std::string& why) {
+  ++counters_.refused_participants;
+  if (auto line = rejections_.note(participant, "participant speaks for no agent: " + why, Clock::now()))
+    log_.warning(*line);
 }
 
 void Agent::reject(const std::string& from, const transport::Rejection& why) {
@@ -148,12 +161,9 @@ void Agent::onEstimate(wire::TransformEstimate&& e) {
   persist(true);
 }
 
-void Agent::onPeer(const std::string& name, bool alive) {
-  const std::string prefix = "tomomapd/";
-  if (name.rfind(prefix, 0) != 0) return;
-  const std::string id = name.substr(prefix.size());
+void Agent::onPeer(const std::string& id, bool alive) {
   if (!config_.isPeer(id)) {
-    log_.debug("participant '" + name + "' is not in the config; its samples will be dropped");
+    if (id != config_.agent()) log_.debug("participant of '" + id + "' is not in the config; its samples will be dropped");
     return;
   }
   if (alive) {

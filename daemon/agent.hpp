@@ -62,6 +62,8 @@ class Agent {
  private:
   struct Counters {
     size_t unknown_agent = 0, rejected = 0, matches_computed = 0;
+    size_t impostors = 0;             ///< samples in another agent's name than their sender's
+    size_t refused_participants = 0;  ///< participants that speak for no agent
   };
 
   // ---- lifecycle (agent_lifecycle.cpp)
@@ -88,7 +90,9 @@ class Agent {
   void onRequest(wire::ChunkRequest&& r);
   void onClaim(wire::MatchClaim&& c);
   void onEstimate(wire::TransformEstimate&& e);
-  void onPeer(const std::string& name, bool alive);
+  void onPeer(const std::string& agent, bool alive);
+  void onImpostor(const std::string& claimed, const std::string& sender);
+  void onRefused(const std::string& participant, const std::string& why);
 
   // ---- what this agent does
   void requestMissing(bool at_once = false);

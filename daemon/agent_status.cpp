@@ -53,7 +53,10 @@ void Agent::persist(bool transforms_changed) {
                           {"matches_computed", counters_.matches_computed},
                           {"computing", computing ? pairText(computing->pair) : ""},
                           {"dropped_unknown_agent", counters_.unknown_agent},
-                          {"rejected_samples", counters_.rejected}};
+                          {"rejected_samples", counters_.rejected},
+                          {"dropped_impostor_samples", counters_.impostors},
+                          {"refused_participants", counters_.refused_participants},
+                          {"secure", config_.transport.security.enabled()}};
     writeJsonAtomically((dir / "status.json").string(), status);
   } catch (const std::exception& e) {
     log_.error(std::string("cannot write state: ") + e.what());

@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -42,7 +43,13 @@ const std::vector<std::string> kKeys{"agent",
                                      "match.consensus_yaw_deg",
                                      "match.min_support",
                                      "match.min_inliers",
-                                     "match.threads"};
+                                     "match.threads",
+                                     "security.ca",
+                                     "security.certificate",
+                                     "security.private_key",
+                                     "security.governance",
+                                     "security.permissions",
+                                     "security.crl"};
 
 struct Reader {
   std::string file;
@@ -124,6 +131,32 @@ void readMatch(const Reader& r, const toml::table& root, MatchParams& m) {
   m.threads = r.integer(*t, "threads", m.threads, 0, 256);
 }
 
+/// The [security] table: DDS Security's files, each of which must exist
+/// (relative paths from the config's folder). All but `crl` are required.
+void readSecurity(const Reader& r, const toml::table& root, const std::function<std::string(const std::string&)>& resolve,
+                  transport::SecurityFiles& f) {
+  const toml::node* node = root.get("security");
+  if (!node) return;
+  const toml::table* t = node->as_table();
+  if (!t) r.fail(*node, "security", "must be a table ([security])");
+  for (const auto& [key, value] : *t)
+    if (std::find(kKeys.begin(), kKeys.end(), "security." + std::string(key.str())) == kKeys.end())
+      r.fail(value, "security." + std::string(key.str()), "unknown key (see docs/configuration.md)");
+  auto file = [&](const std::string& key, bool required) -> std::string {
+    if (!required && !t->get(key)) return "";
+    const std::string path = resolve(r.text(*t, key, std::nullopt));
+    if (!fs::is_regular_file(path))
+      r.fail(*t->get(key), "security." + key, "no such file: " + path + " (tomomap fleet-keys makes them)");
+    return path;
+  };
+  f.ca = file("ca", true);
+  f.certificate = file("certificate", true);
+  f.private_key = file("private_key", true);
+  f.governance = file("governance", true);
+  f.permissions = file("permissions", true);
+  f.crl = file("crl", false);
+}
+
 std::string checkedAddress(const Reader& r, const toml::table& t, const std::string& key,
                            const std::optional<std::string>& fallback) {
   const std::string a = r.text(t, key, fallback);
@@ -157,7 +190,7 @@ Config loadConfig(const std::string& path) {
   auto resolve = [&](const std::string& p) { return (base / p).lexically_normal().string(); };
   for (const auto& [key, node] : root) {
     const std::string k(key.str());
-    if (k != "peer" && k != "match" && std::find(kKeys.begin(), kKeys.end(), k) == kKeys.end())
+    if (k != "peer" && k != "match" && k != "security" && std::find(kKeys.begin(), kKeys.end(), k) == kKeys.end())
       r.fail(node, k, "unknown key (see docs/configuration.md)");
   }
 
@@ -192,6 +225,7 @@ Config loadConfig(const std::string& path) {
   c.request_interval_s = r.number(root, "request_interval_s", 1, 0.1, 600);
   c.peer_memory_mb = r.number(root, "peer_memory_mb", c.peer_memory_mb, 1, 65536);
   t.test_drop_percent = r.integer(root, "test_drop_percent", t.test_drop_percent, 0, 90);
+  readSecurity(r, root, resolve, t.security);
 
   if (const toml::node* peers = root.get("peer")) {
     const toml::array* a = peers->as_array();
@@ -235,6 +269,13 @@ std::string describe(const Config& c) {
     << "\n  match.consensus_translation_cells = " << m.consensus_translation_cells
     << "\n  match.consensus_yaw_deg = " << degrees(m.consensus_yaw) << "\n  match.min_support = " << m.min_support
     << "\n  match.min_inliers = " << m.min_inliers << "\n  match.threads = " << m.threads;
+  const auto& f = t.security;
+  if (f.enabled())
+    o << "\n  security.ca = " << f.ca << "\n  security.certificate = " << f.certificate
+      << "\n  security.private_key = " << f.private_key << "\n  security.governance = " << f.governance
+      << "\n  security.permissions = " << f.permissions << "\n  security.crl = " << f.crl;
+  else
+    o << "\n  security: off (no [security] table)";
   for (const auto& p : t.peers) o << "\n  peer " << p.id << " = " << p.host << ":" << p.port;
   return o.str();
 }

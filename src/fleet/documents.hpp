@@ -9,9 +9,9 @@ namespace tomomap::fleet {
 /// Every tomomap topic's name starts with this; permissions grant on "<prefix>*".
 inline constexpr const char* kTopicPrefix = "tomomap/";
 
-/// Domain-wide rules: only authenticated participants join, every RTPS message
-/// is encrypted and authenticated (AES-GCM), and every topic needs a grant to
-/// read or write.
+/// Domain-wide rules: only authenticated participants join, discovery and
+/// every topic's submessages are encrypted and authenticated (AES-GCM), and
+/// every topic needs a grant to read or write.
 std::string governanceXml();
 
 /// One agent's grant: the certificate subject `subject` may publish and

@@ -12,6 +12,7 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <stdexcept>
 
+#include "senders.hpp"
 #include "tomomapPubSubTypes.h"
 
 namespace tomomap::transport {
@@ -20,36 +21,88 @@ using namespace eprosima::fastdds::dds;
 
 namespace {
 
-/// Takes every sample as it arrives and hands it on.
+SenderDirectory::Prefix prefixOf(const eprosima::fastrtps::rtps::GuidPrefix_t& p) {
+  SenderDirectory::Prefix out{};
+  std::copy(std::begin(p.value), std::end(p.value), out.begin());
+  return out;
+}
+
+// The agent each sample speaks for.
+std::string claimedSender(const wire::MapAnnouncement& a) { return a.agent().to_string(); }
+std::string claimedSender(const wire::SliceFeatures& s) { return s.agent().to_string(); }
+std::string claimedSender(const wire::ChunkRequest& r) { return r.requester().to_string(); }
+std::string claimedSender(const wire::MatchClaim& c) { return c.claimer().to_string(); }
+std::string claimedSender(const wire::TransformEstimate& e) { return e.computed_by().to_string(); }
+
+/// Takes every sample as it arrives and hands on those whose writer's
+/// participant speaks for the agent the sample names.
 template <typename T>
 class Listener : public DataReaderListener {
  public:
-  explicit Listener(std::function<void(T&&)> on) : on_(std::move(on)) {}
+  Listener(const SenderDirectory& senders, std::function<void(T&&)> on, const BusHandlers& h)
+      : senders_(senders), on_(std::move(on)), impostor_(h.impostor) {}
   void on_data_available(DataReader* reader) override {
     T sample;
     SampleInfo info;
-    while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK)
-      if (info.valid_data && on_) on_(std::move(sample));
+    while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      const auto sender = senders_.agentOf(prefixOf(info.sample_identity.writer_guid().guidPrefix));
+      const std::string claimed = claimedSender(sample);
+      if (!sender || *sender != claimed) {
+        if (impostor_) impostor_(claimed, sender.value_or(""));
+        continue;
+      }
+      if (on_) on_(std::move(sample));
+    }
   }
 
  private:
+  const SenderDirectory& senders_;
   std::function<void(T&&)> on_;
+  std::function<void(const std::string&, const std::string&)> impostor_;
 };
 
+/// Binds discovered participants to agents and reports peers coming and going.
 class ParticipantWatch : public DomainParticipantListener {
  public:
-  explicit ParticipantWatch(std::function<void(const std::string&, bool)> on) : on_(std::move(on)) {}
+  ParticipantWatch(SenderDirectory& senders, bool secure, const BusHandlers& h)
+      : senders_(senders), secure_(secure), peer_(h.peer), refused_(h.refused) {}
   void on_participant_discovery(DomainParticipant*,
                                 eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
     using S = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
-    if (!on_) return;
+    const auto prefix = prefixOf(info.info.m_guid.guidPrefix);
     const std::string name = info.info.m_participantName.to_string();
-    if (info.status == S::DISCOVERED_PARTICIPANT) on_(name, true);
-    if (info.status == S::REMOVED_PARTICIPANT || info.status == S::DROPPED_PARTICIPANT) on_(name, false);
+    if (info.status == S::DISCOVERED_PARTICIPANT) {
+      const Binding b = bindParticipant(name, secure_ ? std::optional<std::string>(subjectOf(info.info))
+                                                      : std::nullopt);
+      if (!b.agent) {
+        if (refused_) refused_(name, b.refusal);
+        return;
+      }
+      senders_.bind(prefix, *b.agent);
+      if (peer_) peer_(*b.agent, true);
+    }
+    if (info.status == S::REMOVED_PARTICIPANT || info.status == S::DROPPED_PARTICIPANT) {
+      const auto agent = senders_.agentOf(prefix);
+      senders_.forget(prefix);
+      if (agent && peer_) peer_(*agent, false);
+    }
   }
 
  private:
-  std::function<void(const std::string&, bool)> on_;
+  /// The subject of the certificate the participant authenticated with: its
+  /// identity token carries it, and PKI-DH refuses a participant whose
+  /// certificate's subject differs from its token's. Empty if absent.
+  static std::string subjectOf(const eprosima::fastrtps::rtps::ParticipantProxyData& p) {
+    for (const auto& property : p.identity_token_.properties())
+      if (property.name() == "dds.cert.sn") return property.value();
+    return "";
+  }
+
+  SenderDirectory& senders_;
+  const bool secure_;
+  std::function<void(const std::string&, bool)> peer_;
+  std::function<void(const std::string&, const std::string&)> refused_;
 };
 
 /// QoS shared by the small control topics.
@@ -96,6 +149,8 @@ struct Bus::Impl {
   DomainParticipant* participant = nullptr;
   Publisher* publisher = nullptr;
   Subscriber* subscriber = nullptr;
+  SenderDirectory senders;
+  BusHandlers handlers;
   std::unique_ptr<ParticipantWatch> watch;
   std::vector<std::unique_ptr<DataReaderListener>> listeners;
   DataWriter *announcements = nullptr, *slices = nullptr, *requests = nullptr, *claims = nullptr, *estimates = nullptr;
@@ -125,7 +180,7 @@ struct Bus::Impl {
     }
     DataWriter* w = publisher->create_datawriter(topic, wq);
     if (!w) throw std::runtime_error("cannot create the writer of " + name);
-    listeners.push_back(std::make_unique<Listener<T>>(std::move(on)));
+    listeners.push_back(std::make_unique<Listener<T>>(senders, std::move(on), handlers));
     if (!subscriber->create_datareader(topic, endpointQos(DATAREADER_QOS_DEFAULT, tq), listeners.back().get()))
       throw std::runtime_error("cannot create the reader of " + name);
     return w;
@@ -134,8 +189,10 @@ struct Bus::Impl {
 
 Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<Impl>()) {
   auto& i = *impl_;
-  i.watch = std::make_unique<ParticipantWatch>(h.peer);
+  i.handlers = h;
+  i.watch = std::make_unique<ParticipantWatch>(i.senders, config.security.enabled(), i.handlers);
   i.participant = createParticipant(config, i.watch.get());
+  i.senders.bind(prefixOf(i.participant->guid().guidPrefix), config.agent);  // our own samples
   try {
     i.publisher = i.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
     i.subscriber = i.participant->create_subscriber(SUBSCRIBER_QOS_DEFAULT);

@@ -21,9 +21,13 @@ struct BusHandlers {
   std::function<void(wire::ChunkRequest&&)> request;
   std::function<void(wire::MatchClaim&&)> claim;
   std::function<void(wire::TransformEstimate&&)> estimate;
-  /// A remote participant appeared (true) or was lost (false); its name is
-  /// "tomomapd/<agent>".
-  std::function<void(const std::string& name, bool alive)> peer;
+  /// A participant speaking for `agent` appeared (true) or was lost (false).
+  std::function<void(const std::string& agent, bool alive)> peer;
+  /// A participant that speaks for no agent (senders.hpp): its samples are dropped.
+  std::function<void(const std::string& participant, const std::string& why)> refused;
+  /// A sample naming `claimed` came from a participant speaking for `sender`
+  /// (empty: for none); it was dropped.
+  std::function<void(const std::string& claimed, const std::string& sender)> impostor;
 };
 
 class Bus {

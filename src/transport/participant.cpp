@@ -47,11 +47,17 @@ constexpr size_t kMtuPayload = 1472;  ///< UDP payload of a 1500-byte Ethernet f
 /// RTPS around one sample in a datagram: header, INFO_TS, DATA submessage with
 /// the key hash inline (about 100 bytes seen), with a margin.
 constexpr size_t kRtpsOverhead = 128;
+/// What DDS Security adds to a sample with metadata_protection_kind ENCRYPT:
+/// SEC_PREFIX (24 bytes), SEC_POSTFIX (a 16-byte MAC and its count) and the
+/// encrypted body's framing, with a margin.
+constexpr size_t kSecurityOverhead = 64;
+
+size_t overhead(bool secure) { return kRtpsOverhead + (secure ? kSecurityOverhead : 0); }
 constexpr int kLeaseS = 60;  ///< participant lease; announcements every tenth of it
 
 }  // namespace
 
-size_t maxSampleBytes(double kbps) {
+size_t maxSampleBytes(double kbps, bool secure) {
   // The controller sends whole samples only and a sample that does not fit the
   // rest of a period waits for the next one. Slices vary in size, so with
   // samples of up to an eighth of the period's budget at most about one
@@ -60,7 +66,7 @@ size_t maxSampleBytes(double kbps) {
   // datagram costs its headers; smaller samples paid them more often). And no
   // sample may exceed one UDP datagram.
   constexpr size_t kDatagram = 60000;
-  return std::clamp<size_t>(bytesPerPeriod(kbps) / 8, kMtuPayload, kDatagram) - kRtpsOverhead;
+  return std::clamp<size_t>(bytesPerPeriod(kbps) / 8, kMtuPayload, kDatagram) - overhead(secure);
 }
 
 namespace {
@@ -73,11 +79,31 @@ Locator_t udp(const std::string& host, uint16_t port) {
   return l;
 }
 
+/// DDS Security's built-in plugins from the files: PKI-DH authentication,
+/// permissions checked against the signed documents, AES-GCM-GMAC crypto.
+void addSecurity(const SecurityFiles& f, DomainParticipantQos& q) {
+  auto& props = q.properties().properties();
+  auto add = [&](const std::string& name, const std::string& value) { props.emplace_back(name, value); };
+  auto file = [](const std::string& path) { return "file://" + path; };
+  const std::string auth = "dds.sec.auth.builtin.PKI-DH.", access = "dds.sec.access.builtin.Access-Permissions.";
+  add("dds.sec.auth.plugin", "builtin.PKI-DH");
+  add(auth + "identity_ca", file(f.ca));
+  add(auth + "identity_certificate", file(f.certificate));
+  add(auth + "private_key", file(f.private_key));
+  if (!f.crl.empty()) add(auth + "identity_crl", file(f.crl));
+  add("dds.sec.access.plugin", "builtin.Access-Permissions");
+  add(access + "permissions_ca", file(f.ca));
+  add(access + "governance", file(f.governance));
+  add(access + "permissions", file(f.permissions));
+  add("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+}
+
 }  // namespace
 
 DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipantListener* listener) {
   DomainParticipantQos q;
-  q.name("tomomapd/" + c.agent);
+  q.name(participantName(c.agent));
+  if (c.security.enabled()) addSecurity(c.security, q);
   q.transport().use_builtin_transports = false;
   std::shared_ptr<eprosima::fastdds::rtps::SocketTransportDescriptor> transport;
   if (c.test_drop_percent > 0) {
@@ -96,7 +122,7 @@ DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipant
   // lost fragment loses every sample in the datagram. One sample per datagram,
   // and no datagram above an Ethernet MTU where the samples are that small.
   transport->maxMessageSize =
-      static_cast<uint32_t>(std::max<size_t>(kMtuPayload, maxSampleBytes(c.bandwidth_kbps) + kRtpsOverhead));
+      static_cast<uint32_t>(std::max<size_t>(kMtuPayload, maxSampleBytes(c.bandwidth_kbps, c.security.enabled()) + overhead(c.security.enabled())));
   q.transport().user_transports.push_back(transport);
 
   auto& builtin = q.wire_protocol().builtin;
@@ -121,6 +147,11 @@ DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipant
 
   DomainParticipant* p = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(c.domain),
                                                                                       q, listener, StatusMask::none());
+  if (!p && c.security.enabled())
+    throw std::runtime_error(
+        "cannot create the secure DDS participant: check that the [security] files belong together (the "
+        "certificate and permissions signed by `ca`, the key matching the certificate, none expired), or ports " +
+        std::to_string(c.discovery_port) + "/" + std::to_string(c.data_port) + " on " + c.address + " in use");
   if (!p)
     throw std::runtime_error("cannot create the DDS participant (ports " + std::to_string(c.discovery_port) + "/" +
                              std::to_string(c.data_port) + " on " + c.address + " in use?)");

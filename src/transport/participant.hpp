@@ -19,6 +19,18 @@ struct PeerAddress {
   uint16_t port = 0;  ///< the peer's discovery port
 };
 
+/// DDS Security's files (PEM and S/MIME, docs/operations.md "A secure fleet").
+/// Security is on when `ca` is set; then all but `crl` are set.
+struct SecurityFiles {
+  std::string ca;           ///< the fleet CA: identities and permissions documents
+  std::string certificate;  ///< this agent's certificate (CN=<agent>)
+  std::string private_key;  ///< its key
+  std::string governance;   ///< the signed domain rules
+  std::string permissions;  ///< this agent's signed grant
+  std::string crl;          ///< optional: revoked certificates
+  bool enabled() const { return !ca.empty(); }
+};
+
 struct TransportConfig {
   std::string agent;
   int domain = 0;
@@ -28,6 +40,7 @@ struct TransportConfig {
   std::vector<PeerAddress> peers;
   double bandwidth_kbps = 10000;  ///< budget for slice data [kbit/s]
   int test_drop_percent = 0;      ///< test only: share of sent RTPS messages dropped [%]
+  SecurityFiles security;
 };
 
 /// Flow-controller period [ms] with one receiver: the budget is enforced per period.
@@ -60,8 +73,12 @@ size_t bytesPerPeriod(double bandwidth_kbps);
 /// Largest slice sample: a fraction of the per-period budget, so that the
 /// controller, which sends only whole samples per period, fills each period
 /// nearly to the budget; but at thin budgets one full Ethernet datagram, since
-/// each datagram pays its headers (docs/protocol.md, "Sample size").
-size_t maxSampleBytes(double bandwidth_kbps);
+/// each datagram pays its headers (docs/protocol.md, "Sample size"); less
+/// with security, whose framing each datagram carries too.
+size_t maxSampleBytes(double bandwidth_kbps, bool secure);
+
+/// The participant name an agent's daemon takes: "tomomapd/<agent>".
+std::string participantName(const std::string& agent);
 
 /// Creates the participant; throws std::runtime_error naming the cause.
 /// `listener` is attached at creation: set afterwards, it would miss the peers

@@ -75,7 +75,7 @@ TEST(SliceCodec, RoundTripGivesTheSameFeaturesInAnyOrder) {
 
 TEST(SliceCodec, SamplesFitTheBudgetAndTheCheaperEncodingIsChosen) {
   const MapFeatures& f = sampleMap();
-  const size_t budget = maxSampleBytes(1000);  // 1 Mbit/s
+  const size_t budget = maxSampleBytes(1000, /*secure=*/true);  // 1 Mbit/s
   EXPECT_LE(budget, bytesPerPeriod(1000));
   const MapOffer offer = makeOffer("alpha", f, {}, 1000000, budget);
   size_t features = 0, occupancy = 0;
