@@ -107,7 +107,11 @@ void Agent::onAnnouncement(wire::MapAnnouncement&& a) {
   const uint64_t version = a.version();
   const auto done = peers_.announce(std::move(a), Clock::now());
   if (!done.new_version) return;
-  board_.mapAnnounced(owner, version);
+  for (const auto& t : board_.mapAnnounced(owner, version)) {
+    log_.info("agreed " + pairText(t.pair()) + " from " + t.computed_by + " (held until " + owner +
+              "'s map was announced)");
+    persist(true);
+  }
   if (done.complete) {
     board_.mapHeld(owner);
     persist(false);

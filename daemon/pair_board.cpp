@@ -26,7 +26,26 @@ const char* stateName(PairState s) {
 
 PairBoard::PairBoard(std::string me, BoardTimings timings) : me_(std::move(me)), timings_(timings) {}
 
-void PairBoard::mapAnnounced(const std::string& agent, uint64_t version) { maps_[agent] = {version, agent == me_}; }
+std::vector<AgreedTransform> PairBoard::mapAnnounced(const std::string& agent, uint64_t version) {
+  maps_[agent] = {version, agent == me_};
+  std::vector<AgreedTransform> stored;
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    const PairKey& key = it->first.first;
+    if (key.first != agent && key.second != agent) {
+      ++it;
+      continue;
+    }
+    AgreedTransform t = it->second;
+    const bool settled = versionOf(key.first) && versionOf(key.second);
+    if (!settled) {
+      ++it;
+      continue;
+    }
+    it = pending_.erase(it);
+    if (estimateSeen(t) == Offer::Stored) stored.push_back(std::move(t));
+  }
+  return stored;
+}
 
 void PairBoard::mapHeld(const std::string& agent) {
   if (const auto it = maps_.find(agent); it != maps_.end()) it->second.held = true;
@@ -66,10 +85,14 @@ void PairBoard::claimSeen(const std::string& claimer, const PairAt& claim, Clock
 PairBoard::Offer PairBoard::estimateSeen(AgreedTransform t) {
   const PairKey key = t.pair();
   const auto vt = versionOf(key.first), vs = versionOf(key.second);
-  // Versions we do not know yet count as current: the maps may still be on their way.
-  const bool current = (!vt || *vt == t.target_version) && (!vs || *vs == t.source_version);
+  if ((vt && *vt != t.target_version) || (vs && *vs != t.source_version)) return Offer::Outdated;
+  if (!vt || !vs) {
+    // The announcement may still be on its way (estimates and announcements
+    // travel apart): decide when it is here.
+    pending_[{key, t.computed_by}] = std::move(t);
+    return Offer::Pending;
+  }
   const auto it = results_.find(key);
-  if (!current && it != results_.end()) return Offer::Outdated;  // we hold a result for newer maps
   if (it != results_.end() && it->second.isFor(t.target_version, t.source_version) &&
       !outranks(t.computed_by, it->second.computed_by))
     return Offer::Duplicate;  // the same result again, or a duplicate computation: keep one, deterministically

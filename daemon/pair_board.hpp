@@ -60,7 +60,9 @@ class PairBoard {
 
   // ---- what this agent knows of each map
   /// `agent` announced `version` (not yet held, unless it is ours).
-  void mapAnnounced(const std::string& agent, uint64_t version);
+  /// Returns the estimates held back for this version (estimateSeen) that are
+  /// now stored.
+  std::vector<AgreedTransform> mapAnnounced(const std::string& agent, uint64_t version);
   /// This agent now holds `agent`'s map at its announced version.
   void mapHeld(const std::string& agent);
   /// Our own map has a new version: our claims made with the old one are void.
@@ -75,8 +77,13 @@ class PairBoard {
 
   // ---- from the network
   void claimSeen(const std::string& claimer, const PairAt& claim, Clock::time_point now);
-  /// Whether an estimate from the network was stored.
-  enum class Offer { Stored, Duplicate, Outdated };
+  /// Whether an estimate from the network was stored. Only an estimate for
+  /// the maps' current versions is: one for a version not announced yet is
+  /// held back (Pending, one per pair and computer) until it is, and stored
+  /// then if it is current; one for other versions is refused (Outdated), so
+  /// a replayed old estimate cannot replace a result. Of two estimates for the
+  /// same versions every agent keeps the one of the higher-ranked computer.
+  enum class Offer { Stored, Duplicate, Outdated, Pending };
   Offer estimateSeen(AgreedTransform t);
   /// A peer's participant is gone: its claims are void.
   void agentGone(const std::string& agent);
@@ -126,6 +133,8 @@ class PairBoard {
   std::map<std::string, MapState> maps_;
   std::map<PairKey, Claim> claims_;         ///< the winning claim of other agents per pair
   std::map<PairKey, OwnClaim> own_claims_;  ///< pairs we claimed, at which versions, when
+  /// Estimates for versions not announced yet, per pair and computer.
+  std::map<std::pair<PairKey, std::string>, AgreedTransform> pending_;
   std::optional<PairAt> computing_;
   Clock::time_point claim_renewed_{};  ///< when the computing pair's claim was last published
   std::map<PairKey, AgreedTransform> results_;

@@ -43,6 +43,7 @@ struct BioFree {
 using Bio = std::unique_ptr<BIO, BioFree>;
 
 Bio memory() { return Bio(check(BIO_new(BIO_s_mem()), "cannot allocate a buffer")); }
+/// A read-only buffer over `text`, which must outlive it.
 Bio memory(const std::string& text) {
   return Bio(check(BIO_new_mem_buf(text.data(), static_cast<int>(text.size())), "cannot allocate a buffer"));
 }
@@ -156,12 +157,14 @@ std::string pem(const Key& key) {
 }
 
 Cert readCert(const std::string& path) {
-  Bio in = memory(readFile(path));
+  const std::string text = readFile(path);  // the buffer reads from it: keep it alive
+  Bio in = memory(text);
   return Cert(check(PEM_read_bio_X509(in.get(), nullptr, nullptr, nullptr), path + ": not a PEM certificate"));
 }
 
 Key readKey(const std::string& path) {
-  Bio in = memory(readFile(path));
+  const std::string text = readFile(path);
+  Bio in = memory(text);
   return Key(check(PEM_read_bio_PrivateKey(in.get(), nullptr, nullptr, nullptr), path + ": not a PEM private key"));
 }
 

@@ -226,3 +226,24 @@ TEST(PairBoard, LeavingTheNetworkVoidsEveryClaim) {
   bravo.leftNetwork();
   EXPECT_EQ(bravo.step(t0 + 1s).claims.size(), 1u);
 }
+
+TEST(PairBoard, AReplayedEstimateForOldMapsIsRefusedEvenWithNoResultHeld) {
+  PairBoard charlie("charlie", timings());
+  charlie.mapAnnounced("alpha", 1);
+  charlie.mapAnnounced("bravo", 3);
+  EXPECT_EQ(charlie.estimateSeen(resultOf({kAB, 1, 2}, "alpha")), PairBoard::Offer::Outdated);
+  EXPECT_TRUE(charlie.results().empty());
+}
+
+TEST(PairBoard, AnEstimateAheadOfTheAnnouncementIsHeldUntilItsVersionIsKnown) {
+  PairBoard charlie("charlie", timings());
+  charlie.mapAnnounced("alpha", 1);
+  EXPECT_EQ(charlie.estimateSeen(resultOf({kAB, 1, 2}, "alpha")), PairBoard::Offer::Pending);
+  EXPECT_EQ(charlie.estimateSeen(resultOf({kAB, 1, 5}, "bravo")), PairBoard::Offer::Pending);
+  EXPECT_TRUE(charlie.results().empty()) << "nothing stored before bravo's version is known";
+  const auto stored = charlie.mapAnnounced("bravo", 2);
+  ASSERT_EQ(stored.size(), 1u) << "the estimate for version 2 is stored, the one for 5 dropped";
+  EXPECT_EQ(stored[0].computed_by, "alpha");
+  EXPECT_EQ(charlie.results().at(kAB).source_version, 2u);
+  EXPECT_TRUE(charlie.mapAnnounced("bravo", 5).empty()) << "the dropped one does not come back";
+}

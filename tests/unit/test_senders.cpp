@@ -1,0 +1,41 @@
+// Which agent a participant speaks for: its name, and with security the CN
+// of the certificate it authenticated with, which must agree.
+#include <gtest/gtest.h>
+
+#include "transport/senders.hpp"
+
+using namespace tomomap::transport;
+
+TEST(Senders, CommonNameInEitherSubjectForm) {
+  EXPECT_EQ(commonName("/O=tomomap fleet/CN=alpha"), "alpha");
+  EXPECT_EQ(commonName("CN=alpha,O=tomomap fleet"), "alpha");
+  EXPECT_EQ(commonName("O=x,CN=bravo"), "bravo");
+  EXPECT_FALSE(commonName("/O=tomomap fleet").has_value());
+  EXPECT_FALSE(commonName("O=ACN=alpha").has_value()) << "CN= inside another value is not an attribute";
+}
+
+TEST(Senders, APlainParticipantSpeaksForTheAgentInItsName) {
+  EXPECT_EQ(bindParticipant("tomomapd/alpha", std::nullopt).agent, "alpha");
+  const Binding stranger = bindParticipant("talker", std::nullopt);
+  EXPECT_FALSE(stranger.agent);
+  EXPECT_NE(stranger.refusal.find("talker"), std::string::npos);
+  EXPECT_FALSE(bindParticipant("tomomapd/", std::nullopt).agent);
+}
+
+TEST(Senders, ASecureParticipantSpeaksOnlyForItsCertificatesName) {
+  EXPECT_EQ(bindParticipant("tomomapd/alpha", std::string("/O=tomomap fleet/CN=alpha")).agent, "alpha");
+  const Binding liar = bindParticipant("tomomapd/alpha", std::string("/O=tomomap fleet/CN=charlie"));
+  EXPECT_FALSE(liar.agent);
+  EXPECT_NE(liar.refusal.find("authenticated as charlie"), std::string::npos) << liar.refusal;
+  EXPECT_FALSE(bindParticipant("tomomapd/alpha", std::string("")).agent) << "no subject: no identity";
+}
+
+TEST(Senders, TheDirectoryForgetsAParticipantThatLeft) {
+  SenderDirectory d;
+  const SenderDirectory::Prefix p{1, 2, 3};
+  d.bind(p, "alpha");
+  EXPECT_EQ(d.agentOf(p), "alpha");
+  EXPECT_FALSE(d.agentOf(SenderDirectory::Prefix{9}).has_value());
+  d.forget(p);
+  EXPECT_FALSE(d.agentOf(p).has_value());
+}
