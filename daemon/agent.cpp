@@ -86,7 +86,7 @@ void Agent::onImpostor(const std::string& claimed, const std::string& sender) {
 
 void Agent::onRefused(const std::string& participant, const std::string& why) {
   ++counters_.refused_participants;
-  if (auto line = rejections_.note(participant, "participant speaks for no agent: " + why, Clock::now()))
+  if (auto line = rejections_.note(participant, "its participant speaks for no agent: " + why, Clock::now()))
     log_.warning(*line);
 }
 

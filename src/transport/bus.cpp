@@ -1,6 +1,8 @@
 #include "bus.hpp"
 
 #include <algorithm>
+#include <map>
+#include <mutex>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
@@ -62,36 +64,78 @@ class Listener : public DataReaderListener {
   std::function<void(const std::string&, const std::string&)> impostor_;
 };
 
-/// Binds discovered participants to agents and reports peers coming and going.
+/// Binds participants to agents and reports peers coming and going. With
+/// security a participant is discovered (its announcement is plain text, its
+/// identity token unproven) before it authenticates: it is bound only once
+/// both have happened, in either order.
 class ParticipantWatch : public DomainParticipantListener {
  public:
   ParticipantWatch(SenderDirectory& senders, bool secure, const BusHandlers& h)
       : senders_(senders), secure_(secure), peer_(h.peer), refused_(h.refused) {}
+
   void on_participant_discovery(DomainParticipant*,
                                 eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
     using S = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
     const auto prefix = prefixOf(info.info.m_guid.guidPrefix);
-    const std::string name = info.info.m_participantName.to_string();
     if (info.status == S::DISCOVERED_PARTICIPANT) {
-      const Binding b = bindParticipant(name, secure_ ? std::optional<std::string>(subjectOf(info.info))
-                                                      : std::nullopt);
-      if (!b.agent) {
-        if (refused_) refused_(name, b.refusal);
-        return;
-      }
-      senders_.bind(prefix, *b.agent);
-      if (peer_) peer_(*b.agent, true);
+      std::unique_lock<std::mutex> lock(mutex_);
+      Candidate& c = candidates_[prefix];
+      c.name = info.info.m_participantName.to_string();
+      c.subject = subjectOf(info.info);
+      c.discovered = true;
+      settle(prefix, lock);
     }
     if (info.status == S::REMOVED_PARTICIPANT || info.status == S::DROPPED_PARTICIPANT) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        candidates_.erase(prefix);
+      }
       const auto agent = senders_.agentOf(prefix);
       senders_.forget(prefix);
       if (agent && peer_) peer_(*agent, false);
     }
   }
 
+  void onParticipantAuthentication(DomainParticipant*,
+                                   eprosima::fastrtps::rtps::ParticipantAuthenticationInfo&& info) override {
+    using A = eprosima::fastrtps::rtps::ParticipantAuthenticationInfo;
+    const auto prefix = prefixOf(info.guid.guidPrefix);
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (info.status == A::UNAUTHORIZED_PARTICIPANT) {
+      const std::string name = candidates_.count(prefix) ? candidates_[prefix].name : "a participant";
+      candidates_.erase(prefix);
+      lock.unlock();
+      if (refused_) refused_(name, "it failed authentication (no certificate of this fleet's CA, or no permission)");
+      return;
+    }
+    candidates_[prefix].authorized = true;
+    settle(prefix, lock);
+  }
+
  private:
+  struct Candidate {
+    std::string name, subject;
+    bool discovered = false, authorized = false;
+  };
+
+  /// Binds the candidate once it is known and (with security) authenticated;
+  /// calls back without the lock held.
+  void settle(const SenderDirectory::Prefix& prefix, std::unique_lock<std::mutex>& lock) {
+    const Candidate c = candidates_[prefix];
+    if (!c.discovered || (secure_ && !c.authorized)) return;
+    candidates_.erase(prefix);
+    lock.unlock();
+    const Binding b = bindParticipant(c.name, secure_ ? std::optional<std::string>(c.subject) : std::nullopt);
+    if (!b.agent) {
+      if (refused_) refused_(c.name, b.refusal);
+      return;
+    }
+    senders_.bind(prefix, *b.agent);
+    if (peer_) peer_(*b.agent, true);
+  }
+
   /// The subject of the certificate the participant authenticated with: its
-  /// identity token carries it, and PKI-DH refuses a participant whose
+  /// identity token carries it, and PKI-DH fails a participant whose
   /// certificate's subject differs from its token's. Empty if absent.
   static std::string subjectOf(const eprosima::fastrtps::rtps::ParticipantProxyData& p) {
     for (const auto& property : p.identity_token_.properties())
@@ -103,6 +147,8 @@ class ParticipantWatch : public DomainParticipantListener {
   const bool secure_;
   std::function<void(const std::string&, bool)> peer_;
   std::function<void(const std::string&, const std::string&)> refused_;
+  std::mutex mutex_;
+  std::map<SenderDirectory::Prefix, Candidate> candidates_;  ///< discovered or authenticated, not both yet
 };
 
 /// QoS shared by the small control topics.
