@@ -22,7 +22,7 @@ constexpr auto kMapSettle = std::chrono::milliseconds(1000);
 bool sameNetwork(const transport::TransportConfig& a, const transport::TransportConfig& b) {
   if (a.domain != b.domain || a.address != b.address || a.discovery_port != b.discovery_port ||
       a.data_port != b.data_port || a.bandwidth_kbps != b.bandwidth_kbps ||
-      a.test_drop_percent != b.test_drop_percent || a.peers.size() != b.peers.size())
+      a.test_drop_percent != b.test_drop_percent || !(a.security == b.security) || a.peers.size() != b.peers.size())
     return false;
   for (size_t i = 0; i < a.peers.size(); ++i)
     if (a.peers[i].id != b.peers[i].id || a.peers[i].host != b.peers[i].host || a.peers[i].port != b.peers[i].port)

@@ -4,7 +4,9 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -155,6 +157,12 @@ void readSecurity(const Reader& r, const toml::table& root, const std::function<
   f.governance = file("governance", true);
   f.permissions = file("permissions", true);
   f.crl = file("crl", false);
+  std::string all;
+  for (const auto& path : {f.ca, f.certificate, f.private_key, f.governance, f.permissions, f.crl}) {
+    std::ifstream in(path);
+    all += std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()) + '\0';
+  }
+  f.contents = std::hash<std::string>{}(all);
 }
 
 std::string checkedAddress(const Reader& r, const toml::table& t, const std::string& key,

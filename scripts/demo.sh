@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The demo from a fresh Debian 12 machine: installs what is missing, builds,
 # generates a building mapped by three robots (no data from outside needed),
-# runs three tomomapd daemons as separate processes talking Fast DDS over
-# loopback (config/local-3-agents/), shows their progress, prints the agreed
+# creates the fleet's keys, runs three tomomapd daemons as separate processes
+# talking authenticated, encrypted Fast DDS over loopback (config/local-3-agents/), shows their progress, prints the agreed
 # transforms next to the ground truth, and stops them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,6 +12,9 @@ out=demo-out
 rm -rf "$out"
 echo "== generating a two-floor building seen by three robots (seed 7, low noise)"
 "$build/src/cli/tomomap" synth --world indoor --maps 3 --seed 7 --noise low --out "$out/world" | grep -v '^match with'
+
+echo "== creating the fleet's keys (a CA, a certificate per robot, signed DDS Security documents)"
+"$build/src/cli/tomomap" fleet-keys --agents alpha,bravo,charlie --out "$out/keys" >/dev/null
 
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }

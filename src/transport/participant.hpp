@@ -28,7 +28,15 @@ struct SecurityFiles {
   std::string governance;   ///< the signed domain rules
   std::string permissions;  ///< this agent's signed grant
   std::string crl;          ///< optional: revoked certificates
+  /// A digest of the files' contents when the config was read: a reload
+  /// that finds other contents at the same paths (a new CRL, a renewed
+  /// certificate) joins the network again with them.
+  size_t contents = 0;
   bool enabled() const { return !ca.empty(); }
+  bool operator==(const SecurityFiles& o) const {
+    return ca == o.ca && certificate == o.certificate && private_key == o.private_key && governance == o.governance &&
+           permissions == o.permissions && crl == o.crl && contents == o.contents;
+  }
 };
 
 struct TransportConfig {

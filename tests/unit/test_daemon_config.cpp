@@ -8,6 +8,7 @@
 #include <regex>
 
 #include "config.hpp"
+#include "fleet/fleet_keys.hpp"
 #include "support.hpp"
 
 using namespace tomomap;
@@ -95,7 +96,7 @@ TEST(DaemonConfig, EveryKeyIsInTheReference) {
   const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_FALSE(doc.empty());
   for (std::string key : configKeys()) {
-    for (const std::string table : {"peer.", "match."})
+    for (const std::string table : {"peer.", "match.", "security."})
       if (key.rfind(table, 0) == 0) key = key.substr(table.size());
     EXPECT_NE(doc.find("`" + key + "`"), std::string::npos) << key << " is not in docs/configuration.md";
   }
@@ -105,12 +106,16 @@ TEST(DaemonConfig, EveryKeyInTheReferenceIsOneTheDaemonReads) {
   std::ifstream in(std::string(TOMOMAP_SOURCE_DIR) + "/docs/configuration.md");
   std::string line;
   size_t rows = 0;
-  const std::regex row(R"(^\| (`\[\[peer\]\]` |`\[match\]` )?`([a-z_]+)` \|)");
+  const std::regex row(R"(^\| (`\[\[peer\]\]` |`\[match\]` |`\[security\]` )?`([a-z_]+)` \|)");
   while (std::getline(in, line)) {
     std::smatch m;
     if (!std::regex_search(line, m, row)) continue;
     ++rows;
-    const std::string table = !m[1].matched ? "" : m[1].str().find("peer") != std::string::npos ? "peer." : "match.";
+    const std::string prefix = m[1].str();
+    const std::string table = !m[1].matched                                ? ""
+                              : prefix.find("peer") != std::string::npos     ? "peer."
+                              : prefix.find("security") != std::string::npos ? "security."
+                                                                             : "match.";
     const std::string key = table + m[2].str();
     const auto& keys = configKeys();
     EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end()) << key << " is documented but not read";
@@ -120,12 +125,36 @@ TEST(DaemonConfig, EveryKeyInTheReferenceIsOneTheDaemonReads) {
 
 TEST(DaemonConfig, EveryShippedConfigLoads) {
   // The examples users copy, the local demo's and the containers' configs.
+  // Copies, beside the keys the demo makes where they point (demo-out/keys).
+  namespace fs = std::filesystem;
+  TempDir dir;
+  tomomap::fleet::FleetRequest keys;
+  keys.out = dir / "demo-out/keys";
+  keys.agents = {"alpha", "bravo", "charlie"};
+  tomomap::fleet::makeFleet(keys);
   size_t n = 0;
-  for (const char* folder : {"config", "config/local-3-agents", "docker/config"})
-    for (const auto& e : std::filesystem::directory_iterator(std::string(TOMOMAP_SOURCE_DIR) + "/" + folder)) {
+  for (const char* folder : {"config", "config/local-3-agents", "docker/config"}) {
+    fs::create_directories(dir / folder);
+    for (const auto& e : fs::directory_iterator(std::string(TOMOMAP_SOURCE_DIR) + "/" + folder)) {
       if (e.path().extension() != ".toml") continue;
       ++n;
-      EXPECT_NO_THROW(loadConfig(e.path().string())) << e.path();
+      const fs::path copy = fs::path(dir / folder) / e.path().filename();
+      fs::copy_file(e.path(), copy);
+      EXPECT_NO_THROW(loadConfig(copy.string())) << e.path();
     }
+  }
   EXPECT_GE(n, 7u);
+  EXPECT_TRUE(loadConfig(dir / "config/local-3-agents/alpha.toml").transport.security.enabled()) << "the demo is secure";
+}
+
+TEST(DaemonConfig, SecurityFilesMustExistAndBeComplete) {
+  TempDir dir;
+  const std::string base = "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n[security]\n";
+  EXPECT_NE(errorOf(dir, base + "ca = \"nope.pem\"\n").find("c.toml:5:6: key 'security.ca': no such file"),
+            std::string::npos)
+      << errorOf(dir, base + "ca = \"nope.pem\"\n");
+  std::ofstream(dir / "ca.pem") << "x";
+  EXPECT_NE(errorOf(dir, base + "ca = \"ca.pem\"\n").find("key 'certificate' is required"), std::string::npos)
+      << errorOf(dir, base + "ca = \"ca.pem\"\n");
+  EXPECT_NE(errorOf(dir, base + "cert = \"ca.pem\"\n").find("key 'security.cert': unknown key"), std::string::npos);
 }
