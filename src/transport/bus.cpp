@@ -64,14 +64,12 @@ class Listener : public DataReaderListener {
   std::function<void(const std::string&, const std::string&)> impostor_;
 };
 
-/// Binds participants to agents and reports peers coming and going. With
-/// security a participant is discovered (its announcement is plain text, its
-/// identity token unproven) before it authenticates: it is bound only once
-/// both have happened, in either order.
+/// Binds participants to agents (senders.hpp, Admission) and reports peers
+/// coming and going. Fast DDS calls it on its own threads.
 class ParticipantWatch : public DomainParticipantListener {
  public:
   ParticipantWatch(SenderDirectory& senders, bool secure, const BusHandlers& h)
-      : senders_(senders), secure_(secure), peer_(h.peer), refused_(h.refused) {}
+      : senders_(senders), admission_(secure), peer_(h.peer), refused_(h.refused) {}
 
   void on_participant_discovery(DomainParticipant*,
                                 eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
@@ -79,16 +77,14 @@ class ParticipantWatch : public DomainParticipantListener {
     const auto prefix = prefixOf(info.info.m_guid.guidPrefix);
     if (info.status == S::DISCOVERED_PARTICIPANT) {
       std::unique_lock<std::mutex> lock(mutex_);
-      Candidate& c = candidates_[prefix];
-      c.name = info.info.m_participantName.to_string();
-      c.subject = subjectOf(info.info);
-      c.discovered = true;
-      settle(prefix, lock);
+      const auto b = admission_.discovered(prefix, info.info.m_participantName.to_string(), subjectOf(info.info));
+      lock.unlock();
+      apply(prefix, b, info.info.m_participantName.to_string());
     }
     if (info.status == S::REMOVED_PARTICIPANT || info.status == S::DROPPED_PARTICIPANT) {
       {
         std::lock_guard<std::mutex> lock(mutex_);
-        candidates_.erase(prefix);
+        admission_.gone(prefix);
       }
       const auto agent = senders_.agentOf(prefix);
       senders_.forget(prefix);
@@ -102,36 +98,25 @@ class ParticipantWatch : public DomainParticipantListener {
     const auto prefix = prefixOf(info.guid.guidPrefix);
     std::unique_lock<std::mutex> lock(mutex_);
     if (info.status == A::UNAUTHORIZED_PARTICIPANT) {
-      const std::string name = candidates_.count(prefix) ? candidates_[prefix].name : "a participant";
-      candidates_.erase(prefix);
+      const std::string name = admission_.failed(prefix);
       lock.unlock();
-      if (refused_) refused_(name, "it failed authentication (no certificate of this fleet's CA, or no permission)");
+      if (refused_) refused_(name, "a handshake failed (no certificate of this fleet's CA, or no permission)");
       return;
     }
-    candidates_[prefix].authorized = true;
-    settle(prefix, lock);
+    const auto b = admission_.authenticated(prefix);
+    lock.unlock();
+    apply(prefix, b, "");
   }
 
  private:
-  struct Candidate {
-    std::string name, subject;
-    bool discovered = false, authorized = false;
-  };
-
-  /// Binds the candidate once it is known and (with security) authenticated;
-  /// calls back without the lock held.
-  void settle(const SenderDirectory::Prefix& prefix, std::unique_lock<std::mutex>& lock) {
-    const Candidate c = candidates_[prefix];
-    if (!c.discovered || (secure_ && !c.authorized)) return;
-    candidates_.erase(prefix);
-    lock.unlock();
-    const Binding b = bindParticipant(c.name, secure_ ? std::optional<std::string>(c.subject) : std::nullopt);
-    if (!b.agent) {
-      if (refused_) refused_(c.name, b.refusal);
+  void apply(const SenderDirectory::Prefix& prefix, const std::optional<Binding>& b, const std::string& name) {
+    if (!b) return;
+    if (!b->agent) {
+      if (refused_) refused_(name.empty() ? "a participant" : name, b->refusal);
       return;
     }
-    senders_.bind(prefix, *b.agent);
-    if (peer_) peer_(*b.agent, true);
+    senders_.bind(prefix, *b->agent);
+    if (peer_) peer_(*b->agent, true);
   }
 
   /// The subject of the certificate the participant authenticated with: its
@@ -144,11 +129,10 @@ class ParticipantWatch : public DomainParticipantListener {
   }
 
   SenderDirectory& senders_;
-  const bool secure_;
+  std::mutex mutex_;
+  Admission admission_;  ///< under mutex_
   std::function<void(const std::string&, bool)> peer_;
   std::function<void(const std::string&, const std::string&)> refused_;
-  std::mutex mutex_;
-  std::map<SenderDirectory::Prefix, Candidate> candidates_;  ///< discovered or authenticated, not both yet
 };
 
 /// QoS shared by the small control topics.

@@ -31,6 +31,34 @@ Binding bindParticipant(const std::string& participant_name, const std::optional
   return {agent, ""};
 }
 
+std::optional<Binding> Admission::discovered(const Prefix& p, const std::string& name, const std::string& subject) {
+  Candidate& c = candidates_[p];
+  c.name = name;
+  c.subject = subject;
+  c.discovered = true;
+  return settle(p);
+}
+
+std::optional<Binding> Admission::authenticated(const Prefix& p) {
+  candidates_[p].authenticated = true;
+  return settle(p);
+}
+
+std::string Admission::failed(const Prefix& p) {
+  Candidate& c = candidates_[p];
+  c.authenticated = false;
+  return c.name.empty() ? "a participant" : c.name;
+}
+
+void Admission::gone(const Prefix& p) { candidates_.erase(p); }
+
+std::optional<Binding> Admission::settle(const Prefix& p) {
+  const Candidate c = candidates_[p];
+  if (!c.discovered || (secure_ && !c.authenticated)) return std::nullopt;
+  candidates_.erase(p);
+  return bindParticipant(c.name, secure_ ? std::optional<std::string>(c.subject) : std::nullopt);
+}
+
 void SenderDirectory::bind(const Prefix& participant, const std::string& agent) {
   std::lock_guard<std::mutex> lock(mutex_);
   agents_[participant] = agent;

@@ -26,6 +26,33 @@ Binding bindParticipant(const std::string& participant_name, const std::optional
 /// The common name (CN) in a subject of either form; none if it has none.
 std::optional<std::string> commonName(const std::string& subject);
 
+/// Decides when a participant is bound. With security, discovery (its
+/// announcement: plain text, the identity token unproven) and authentication
+/// are reported apart and in either order, and a handshake that fails can be
+/// followed by one that succeeds (handshakes of two peers cross): a
+/// participant is bound once it was discovered and its latest handshake
+/// succeeded. Without security, on discovery. Not thread-safe.
+class Admission {
+ public:
+  using Prefix = std::array<uint8_t, 12>;
+  explicit Admission(bool secure) : secure_(secure) {}
+  /// The binding to make now, if any.
+  std::optional<Binding> discovered(const Prefix& p, const std::string& name, const std::string& subject);
+  std::optional<Binding> authenticated(const Prefix& p);
+  /// A failed handshake: the name to report it under ("a participant" if unknown).
+  std::string failed(const Prefix& p);
+  void gone(const Prefix& p);
+
+ private:
+  struct Candidate {
+    std::string name, subject;
+    bool discovered = false, authenticated = false;
+  };
+  std::optional<Binding> settle(const Prefix& p);
+  const bool secure_;
+  std::map<Prefix, Candidate> candidates_;  ///< discovered or authenticated, not bound yet
+};
+
 /// Participants known to speak for an agent, by GUID prefix (12 bytes).
 /// Written by discovery, read by every reader's listener: thread-safe.
 class SenderDirectory {

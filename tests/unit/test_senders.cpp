@@ -39,3 +39,33 @@ TEST(Senders, TheDirectoryForgetsAParticipantThatLeft) {
   d.forget(p);
   EXPECT_FALSE(d.agentOf(p).has_value());
 }
+
+TEST(Senders, ASecureParticipantIsBoundOnceDiscoveredAndAuthenticatedInEitherOrder) {
+  const Admission::Prefix a{1}, b{2};
+  Admission desk(/*secure=*/true);
+  EXPECT_FALSE(desk.discovered(a, "tomomapd/alpha", "/O=f/CN=alpha")) << "discovery alone proves nothing";
+  const auto bound = desk.authenticated(a);
+  ASSERT_TRUE(bound);
+  EXPECT_EQ(bound->agent, "alpha");
+  EXPECT_FALSE(desk.authenticated(b));
+  EXPECT_EQ(desk.discovered(b, "tomomapd/bravo", "/O=f/CN=bravo")->agent, "bravo");
+}
+
+TEST(Senders, AFailedHandshakeFollowedByASuccessfulOneStillBinds) {
+  // Two peers' handshakes crossed: one failed, the next succeeded (seen with
+  // three daemons started together; binding was lost for good before).
+  const Admission::Prefix a{1};
+  Admission desk(/*secure=*/true);
+  EXPECT_FALSE(desk.discovered(a, "tomomapd/alpha", "/O=f/CN=alpha"));
+  EXPECT_EQ(desk.failed(a), "tomomapd/alpha");
+  const auto bound = desk.authenticated(a);
+  ASSERT_TRUE(bound);
+  EXPECT_EQ(bound->agent, "alpha");
+}
+
+TEST(Senders, APlainParticipantIsBoundOnDiscovery) {
+  Admission desk(/*secure=*/false);
+  const auto bound = desk.discovered(Admission::Prefix{7}, "tomomapd/alpha", "");
+  ASSERT_TRUE(bound);
+  EXPECT_EQ(bound->agent, "alpha");
+}
