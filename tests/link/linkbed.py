@@ -239,6 +239,7 @@ def main():
                         "or whole, by the application rather than repaired by RTPS)")
     p.add_argument("--max-peak-ratio", type=float, help="fail if an agent's peak 5 s egress exceeds this x budget")
     p.add_argument("--keep", help="keep configs, logs and state in this folder")
+    p.add_argument("--secure", action="store_true", help="DDS Security on (keys from `tomomap fleet-keys`)")
     args = p.parse_args()
     if os.geteuid() != 0:
         print("linkbed: needs root (network namespaces)", file=sys.stderr)
@@ -253,19 +254,33 @@ def main():
         print(gen.stdout + gen.stderr, file=sys.stderr)
         return 2
 
+    if args.secure:
+        keys = run(args.tomomap, "fleet-keys", "--agents", ",".join(f"a{i}" for i in range(n)), "-o", f"{work}/keys",
+                   check=False)
+        if keys.returncode != 0:
+            print(keys.stdout + keys.stderr, file=sys.stderr)
+            return 2
+
+    def security_lines(i):
+        if not args.secure:
+            return []
+        d = f"{work}/keys/a{i}"
+        return ["[security]", f'ca = "{d}/ca.pem"', f'certificate = "{d}/cert.pem"', f'private_key = "{d}/key.pem"',
+                f'governance = "{d}/governance.p7s"', f'permissions = "{d}/permissions.p7s"']
+
     bed = Bed(n, args.rate_kbit, args.prefix, Impairment(args.loss, args.delay_ms, args.dropout_at, args.dropout_s))
     procs = []
     stop = {"now": False}
     signal.signal(signal.SIGTERM, lambda *_: stop.update(now=True))
     report = {"agents": n, "rate_kbit": args.rate_kbit, "budget_kbps": args.budget_kbps, "loss_percent": args.loss,
               "delay_ms": args.delay_ms, "dropout": [args.dropout_at, args.dropout_s] if args.dropout_at else None,
-              "dds_drop_percent": args.dds_drop, "per_agent": {}}
+              "dds_drop_percent": args.dds_drop, "secure": args.secure, "per_agent": {}}
     try:
         bed.up()
         for i in range(n):
             cfg = f"{work}/a{i}.toml"
             write_config(cfg, i, n, bed, f"{work}/world/map_{i}.pcd", f"{work}/out-a{i}", args.budget_kbps,
-                         [f"grid = {args.grid}", f"test_drop_percent = {args.dds_drop}"])
+                         [f"grid = {args.grid}", f"test_drop_percent = {args.dds_drop}"] + security_lines(i))
             log = open(f"{work}/a{i}.log", "w")
             procs.append(subprocess.Popen(["ip", "netns", "exec", bed.ns(i), args.tomomapd, "--config", cfg],
                                           stdout=log, stderr=subprocess.STDOUT))
