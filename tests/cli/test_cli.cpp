@@ -216,3 +216,20 @@ TEST(Cli, StatusWithoutADaemonsStateSaysSo) {
   std::ofstream(dir / "status.json") << "{\"agent\": \"alpha\"}";
   expectBadInput(runTomomap("status " + dir.path.string()), "not a tomomapd status file");
 }
+
+TEST(Cli, FleetKeysMakesAFleetAndRefusesBadRequests) {
+  TempDir dir;
+  const auto made = runTomomap("fleet-keys --agents alpha,bravo -o " + (dir / "fleet"));
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  EXPECT_NE(made.output.find("keep ca.key on this machine only"), std::string::npos) << made.output;
+  EXPECT_NE(made.output.find("[security]"), std::string::npos) << "prints the config table to add";
+  for (const std::string f : {"ca.pem", "ca.key", "alpha/key.pem", "alpha/cert.pem", "bravo/permissions.p7s"})
+    EXPECT_TRUE(std::filesystem::exists(dir / ("fleet/" + f))) << f;
+  expectBadInput(runTomomap("fleet-keys --agents alpha -o " + (dir / "fleet")), "--replace");
+  expectBadInput(runTomomap("fleet-keys --agents 'bad id' -o " + (dir / "fleet")), "agent id 'bad id'");
+  expectBadInput(runTomomap("fleet-keys -o " + (dir / "fleet")), "nothing to do");
+  expectBadInput(runTomomap("fleet-keys --revoke zulu -o " + (dir / "fleet")), "cannot revoke zulu");
+  const auto revoked = runTomomap("fleet-keys --revoke bravo -o " + (dir / "fleet"));
+  EXPECT_EQ(revoked.exit_code, 0) << revoked.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "fleet/crl.pem"));
+}
