@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/rtps/flowcontrol/FlowControllerDescriptor.hpp>
@@ -31,8 +32,12 @@ size_t receivers(const TransportConfig& c) { return std::max<size_t>(1, c.peers.
 double controlShare(const TransportConfig& c) {
   // 13 % with two receivers (peaks 743-770 kbit/s of 800 seen with 10 %), 21 %
   // with four and 29 % with six (with 10 %: peaks up to 921 and 958 kbit/s).
-  constexpr double kBase = 0.05, kPerReceiver = 0.04, kMax = 0.5;
-  return std::min(kMax, kBase + kPerReceiver * static_cast<double>(receivers(c)));
+  // Security adds handshakes (about 5 kB each way per peer), secure discovery
+  // and a MAC on every heartbeat and acknowledgement: with 13 % for two
+  // receivers a peak of 818 kbit/s of 800 was seen.
+  constexpr double kBase = 0.05, kPerReceiver = 0.04, kSecure = 0.05, kMax = 0.5;
+  return std::min(kMax, kBase + kPerReceiver * static_cast<double>(receivers(c)) +
+                            (c.security.enabled() ? kSecure : 0.0));
 }
 
 double streamKbps(const TransportConfig& c) {
@@ -53,6 +58,18 @@ constexpr size_t kRtpsOverhead = 128;
 constexpr size_t kSecurityOverhead = 64;
 
 size_t overhead(bool secure) { return kRtpsOverhead + (secure ? kSecurityOverhead : 0); }
+
+/// The largest datagram DDS Security's handshake needs: its messages carry the
+/// certificate and the signed permissions and are never fragmented (with
+/// datagrams of 1,472 bytes Fast DDS logged "Cannot serialize
+/// ParticipantGenericMessage" and no peer ever authenticated). The rest of a
+/// handshake message (participant data, key agreement, signatures, names)
+/// took under 2 kB; 4 kB of margin.
+size_t handshakeBytes(const SecurityFiles& f) {
+  std::error_code ec;
+  const auto size = [&](const std::string& path) { return static_cast<size_t>(std::filesystem::file_size(path, ec)); };
+  return size(f.certificate) + size(f.permissions) + 4096;
+}
 constexpr int kLeaseS = 60;  ///< participant lease; announcements every tenth of it
 
 }  // namespace
@@ -120,9 +137,12 @@ DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipant
   // RTPS packs several samples into one datagram up to this size (64 kB by
   // default), which IP then cuts into MTU-sized fragments: on a lossy link one
   // lost fragment loses every sample in the datagram. One sample per datagram,
-  // and no datagram above an Ethernet MTU where the samples are that small.
-  transport->maxMessageSize =
-      static_cast<uint32_t>(std::max<size_t>(kMtuPayload, maxSampleBytes(c.bandwidth_kbps, c.security.enabled()) + overhead(c.security.enabled())));
+  // and no datagram above an Ethernet MTU where the samples are that small;
+  // except with security, whose handshake needs larger ones.
+  const size_t sample = maxSampleBytes(c.bandwidth_kbps, c.security.enabled()) + overhead(c.security.enabled());
+  size_t datagram = std::max(kMtuPayload, sample);
+  if (c.security.enabled()) datagram = std::max(datagram, handshakeBytes(c.security));
+  transport->maxMessageSize = static_cast<uint32_t>(datagram);
   q.transport().user_transports.push_back(transport);
 
   auto& builtin = q.wire_protocol().builtin;
@@ -141,8 +161,22 @@ DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipant
   flow->scheduler = eprosima::fastdds::rtps::FlowControllerSchedulerPolicy::FIFO;
   // Per stretched period, the stream's share for every receiver: each byte
   // written leaves once per receiver, so the egress stays within the budget.
-  flow->max_bytes_per_period = static_cast<int32_t>(bytesPerPeriod((1 - controlShare(c)) * c.bandwidth_kbps));
-  flow->period_ms = static_cast<uint64_t>(flowPeriodMs(c));
+  size_t bytes = bytesPerPeriod((1 - controlShare(c)) * c.bandwidth_kbps);
+  int period = flowPeriodMs(c);
+  if (datagram > sample) {
+    // Datagrams may be larger than one sample (security's handshake): the
+    // controller would hand a period's samples to RTPS together, packed into
+    // one datagram that IP fragments, and one lost fragment would lose them
+    // all (10 % loss: 2.1-2.2 x the payload on the wire). One sample per
+    // period, the period shortened to keep the rate.
+    const int shorter = static_cast<int>((static_cast<size_t>(period) * sample + bytes - 1) / bytes);
+    if (shorter < period) {
+      bytes = bytes * static_cast<size_t>(shorter) / static_cast<size_t>(period);
+      period = shorter;
+    }
+  }
+  flow->max_bytes_per_period = static_cast<int32_t>(bytes);
+  flow->period_ms = static_cast<uint64_t>(period);
   q.flow_controllers().push_back(flow);
 
   DomainParticipant* p = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(c.domain),
