@@ -161,22 +161,8 @@ DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipant
   flow->scheduler = eprosima::fastdds::rtps::FlowControllerSchedulerPolicy::FIFO;
   // Per stretched period, the stream's share for every receiver: each byte
   // written leaves once per receiver, so the egress stays within the budget.
-  size_t bytes = bytesPerPeriod((1 - controlShare(c)) * c.bandwidth_kbps);
-  int period = flowPeriodMs(c);
-  if (datagram > sample) {
-    // Datagrams may be larger than one sample (security's handshake): the
-    // controller would hand a period's samples to RTPS together, packed into
-    // one datagram that IP fragments, and one lost fragment would lose them
-    // all (10 % loss: 2.1-2.2 x the payload on the wire). One sample per
-    // period, the period shortened to keep the rate.
-    const int shorter = static_cast<int>((static_cast<size_t>(period) * sample + bytes - 1) / bytes);
-    if (shorter < period) {
-      bytes = bytes * static_cast<size_t>(shorter) / static_cast<size_t>(period);
-      period = shorter;
-    }
-  }
-  flow->max_bytes_per_period = static_cast<int32_t>(bytes);
-  flow->period_ms = static_cast<uint64_t>(period);
+  flow->max_bytes_per_period = static_cast<int32_t>(bytesPerPeriod((1 - controlShare(c)) * c.bandwidth_kbps));
+  flow->period_ms = static_cast<uint64_t>(flowPeriodMs(c));
   q.flow_controllers().push_back(flow);
 
   DomainParticipant* p = DomainParticipantFactory::get_instance()->create_participant(static_cast<DomainId_t>(c.domain),

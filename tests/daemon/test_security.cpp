@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
+#include <fstream>
+#include <random>
 
 #include "fleet.hpp"
 #include "fleet/fleet_keys.hpp"
@@ -119,4 +122,140 @@ TEST(Security, ASecureFleetAgreesAndNeitherStrangersNorLiarsChangeIt) {
     EXPECT_EQ(kept["T_target_source"]["x"], real["T_target_source"]["x"]) << id << " kept the true transform";
     EXPECT_EQ(kept["computed_by"], real["computed_by"]);
   }
+}
+
+namespace {
+
+/// Resident and peak memory of a process [kB], from /proc.
+std::pair<long, long> memoryKb(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  long rss = 0, peak = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("VmRSS:", 0) == 0) rss = std::stol(line.substr(6));
+    if (line.rfind("VmHWM:", 0) == 0) peak = std::stol(line.substr(6));
+  }
+  return {rss, peak};
+}
+
+size_t countOf(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST(Identity, AHundredThousandFuzzedSamplesCrashNothingAndLeaveMemoryFlat) {
+  TempDir dir;
+  ASSERT_EQ(runTomomap("synth -o " + (dir / "world") + " -n 1 --noise low -s 3 --scale 0.5").exit_code, 0);
+  Fleet fleet(dir);
+  // alpha lists bravo, whose daemon never starts: the fuzzer takes its name,
+  // so every sample passes the identity check and reaches validation.
+  const std::vector<AgentSpec> agents{{"alpha", dir / "world/map_0.pcd"}, {"bravo", dir / "absent.pcd"}};
+  fleet.start(agents[0], agents);
+  ASSERT_TRUE(Fleet::waitFor([&] { return fleet.log("alpha").find("ready:") != std::string::npos; }, 60s))
+      << fleet.log("alpha");
+  Intruder fuzzer("bravo", fleet.port(10), {{"alpha", "127.0.0.1", fleet.port(0)}});
+  ASSERT_TRUE(Fleet::waitFor([&] { return fuzzer.peers_up >= 1; }, 60s));
+  ASSERT_TRUE(Fleet::waitFor([&] { return fleet.log("alpha").find("peer bravo is up") != std::string::npos; }, 60s));
+  const long rss_before = memoryKb(fleet.pid("alpha")).first;
+
+  std::mt19937_64 rng(12345);
+  auto any = [&](uint64_t n) { return n ? rng() % n : rng(); };
+  auto anyDouble = [&] {
+    const double pick[] = {0.0, -1.0, 1e300, std::nan(""), INFINITY, 0.05, -1e-300};
+    return any(3) == 0 ? pick[any(7)] : std::ldexp(static_cast<double>(any(0)), static_cast<int>(any(200)) - 100);
+  };
+  constexpr int kSamples = 100000;
+  for (int i = 0; i < kSamples; ++i) {
+    switch (i % 5) {
+      case 0: {
+        wire::MapAnnouncement a;
+        a.agent("bravo");
+        a.version(any(0));
+        a.grid(anyDouble());
+        a.x_min(anyDouble());
+        a.width(static_cast<uint16_t>(any(0)));
+        a.height(static_cast<uint16_t>(any(0)));
+        a.slice_count(static_cast<int32_t>(any(0)));
+        for (uint64_t s = any(8); s > 0; --s) {
+          wire::SliceEntry e;
+          e.slice(static_cast<int32_t>(any(0)));
+          e.parts(static_cast<uint16_t>(any(0)));
+          e.bytes(static_cast<uint32_t>(any(0)));
+          a.slices().push_back(e);
+        }
+        fuzzer.bus->publish(a);
+        break;
+      }
+      case 1: {
+        wire::SliceFeatures s;
+        s.agent("bravo");
+        s.version(any(4));
+        s.slice(static_cast<int32_t>(any(1000)));
+        s.part(static_cast<uint16_t>(any(10)));
+        s.parts(static_cast<uint16_t>(any(0)));
+        s.encoding(any(2) ? wire::SliceEncoding::FEATURES : wire::SliceEncoding::OCCUPANCY);
+        for (uint64_t k = any(20); k > 0; --k) {
+          wire::Feature f;
+          f.u(static_cast<uint16_t>(any(0)));
+          f.v(static_cast<uint16_t>(any(0)));
+          s.features().push_back(f);
+        }
+        for (uint64_t k = any(200); k > 0; --k) s.occupancy().push_back(static_cast<uint8_t>(any(256)));
+        fuzzer.bus->publish(s);
+        break;
+      }
+      case 2: {
+        wire::ChunkRequest r;
+        r.requester("bravo");
+        r.owner(any(2) ? "alpha" : "zulu");
+        r.version(any(0));
+        r.stalled_ms(static_cast<uint32_t>(any(0)));
+        for (uint64_t k = any(50); k > 0; --k) r.slices().push_back(static_cast<int32_t>(any(0)));
+        fuzzer.bus->publish(r);
+        break;
+      }
+      case 3: {
+        wire::MatchClaim c;
+        c.target(any(2) ? "alpha" : "zulu");
+        c.source("bravo");
+        c.target_version(any(0));
+        c.source_version(any(0));
+        c.claimer("bravo");
+        fuzzer.bus->publish(c);
+        break;
+      }
+      default: {
+        wire::TransformEstimate e;
+        e.target("alpha");
+        e.source("bravo");
+        e.target_version(any(0));
+        e.source_version(any(0));
+        e.reliable(any(2));
+        e.x(anyDouble());
+        e.yaw(anyDouble());
+        e.support(static_cast<int32_t>(any(0)));
+        e.computed_by("bravo");
+        fuzzer.bus->publish(e);
+        break;
+      }
+    }
+  }
+  // Every kind was rejected, and the daemon still answers (status each second).
+  EXPECT_TRUE(Fleet::waitFor([&] { return statusCount(fleet, "alpha", "rejected_samples") > 1000; }, 120s))
+      << fleet.readJson("alpha", "status.json").dump(2);
+  EXPECT_FALSE(fleet.waitExit("alpha", 100ms).has_value()) << "alive\n" << fleet.log("alpha");
+  const auto [rss_after, peak] = memoryKb(fleet.pid("alpha"));
+  EXPECT_LT(rss_after - rss_before, 64 * 1024) << "RSS " << rss_before << " -> " << rss_after << " kB";
+  std::cerr << "alpha RSS " << rss_before << " kB before, " << rss_after << " kB after " << kSamples
+            << " fuzzed samples; peak " << peak << " kB; rejected "
+            << statusCount(fleet, "alpha", "rejected_samples") << "\n";
+  EXPECT_TRUE(fleet.transforms("alpha").empty()) << "nothing stored from fuzz";
+  EXPECT_LE(countOf(fleet.log("alpha"), "rejected"), 5u) << "one line, then a summary a minute\n"
+                                                          << fleet.log("alpha");
+  fleet.kill("alpha", SIGTERM);
+  const auto code = fleet.waitExit("alpha", 2000ms);
+  ASSERT_TRUE(code.has_value()) << "stops within 2 s";
+  EXPECT_EQ(*code, 0);
 }
