@@ -21,6 +21,7 @@ namespace {
 /// A participant of our own making that joins the fleet's peers as `name`.
 struct Intruder {
   std::atomic<int> peers_up{0};
+  std::atomic<int> bravo_read{0};  ///< bravo's announcements it received
   std::unique_ptr<transport::Bus> bus;
 
   Intruder(const std::string& name, uint16_t port, const std::vector<transport::PeerAddress>& fleet,
@@ -33,6 +34,7 @@ struct Intruder {
     c.security = files;
     transport::BusHandlers h;
     h.peer = [this](const std::string&, bool alive) { peers_up += alive ? 1 : 0; };
+    h.announcement = [this](wire::MapAnnouncement&& a) { bravo_read += a.agent().to_string() == "bravo"; };
     bus = std::make_unique<transport::Bus>(c, h);
   }
 
@@ -102,6 +104,8 @@ TEST(Security, ASecureFleetAgreesAndNeitherStrangersNorLiarsChangeIt) {
   // writing an estimate in alpha's name. Each forges the transform.
   Intruder stranger("alpha", fleet.port(10), peers, robotFiles(dir / "other-fleet/alpha"));
   stranger.forge(real, "alpha");
+  Intruder plain("alpha", fleet.port(16), peers);
+  plain.forge(real, "alpha");
   Intruder liar("alpha", fleet.port(12), peers, robotFiles(dir / "keys/charlie"));
   liar.forge(real, "alpha");
   Intruder charlie("charlie", fleet.port(14), peers, robotFiles(dir / "keys/charlie"));
@@ -117,6 +121,9 @@ TEST(Security, ASecureFleetAgreesAndNeitherStrangersNorLiarsChangeIt) {
   EXPECT_NE(fleet.log("bravo").find("authenticated as charlie"), std::string::npos) << fleet.log("bravo");
   // The stranger started first and had as long as the others: it never got in.
   EXPECT_EQ(stranger.peers_up, 0) << "a certificate from another CA does not authenticate";
+  EXPECT_TRUE(Fleet::waitFor([&] { return charlie.bravo_read > 0; }, 60s)) << "a fleet member reads the topics";
+  EXPECT_EQ(stranger.bravo_read, 0) << "the stranger reads none of the topics";
+  EXPECT_EQ(plain.bravo_read, 0) << "a participant without security reads none of the topics";
   for (const std::string id : {"alpha", "bravo"}) {
     const auto kept = fleet.transforms(id).at("alpha<-bravo");
     EXPECT_EQ(kept["T_target_source"]["x"], real["T_target_source"]["x"]) << id << " kept the true transform";
