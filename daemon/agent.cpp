@@ -30,8 +30,9 @@ OwnMap describeOwnMap(const Config& config) {
     validateMap(map, config.map);
     return std::make_shared<MapFeatures>(describeMap(map, config.match, nullptr, &own.cells));
   }();
-  own.offer = transport::makeOffer(config.agent(), *features, config.match.features, binaryPcdBytes(own.cells),
-                                   transport::maxSampleBytes(config.transport.bandwidth_kbps, config.transport.security.enabled()));
+  own.offer = transport::makeOffer(
+      config.agent(), *features, config.match.features, binaryPcdBytes(own.cells),
+      transport::maxSampleBytes(config.transport.bandwidth_kbps, config.transport.security.enabled()));
   own.features = std::move(features);
   own.seconds = seconds(Clock::now() - t0);
   return own;
@@ -167,7 +168,8 @@ void Agent::onEstimate(wire::TransformEstimate&& e) {
 
 void Agent::onPeer(const std::string& id, bool alive) {
   if (!config_.isPeer(id)) {
-    if (id != config_.agent()) log_.debug("participant of '" + id + "' is not in the config; its samples will be dropped");
+    if (id != config_.agent())
+      log_.debug("participant of '" + id + "' is not in the config; its samples will be dropped");
     return;
   }
   if (alive) {

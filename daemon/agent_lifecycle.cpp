@@ -164,7 +164,9 @@ int Agent::run(Signals& signals) {
     post([this, e = std::move(e)]() mutable { onEstimate(std::move(e)); });
   };
   h.peer = [this](const std::string& agent, bool alive) { post([this, agent, alive] { onPeer(agent, alive); }); };
-  h.refused = [this](const std::string& who, const std::string& why) { post([this, who, why] { onRefused(who, why); }); };
+  h.refused = [this](const std::string& who, const std::string& why) {
+    post([this, who, why] { onRefused(who, why); });
+  };
   h.impostor = [this](const std::string& claimed, const std::string& sender) {
     post([this, claimed, sender] { onImpostor(claimed, sender); });
   };

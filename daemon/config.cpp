@@ -135,8 +135,8 @@ void readMatch(const Reader& r, const toml::table& root, MatchParams& m) {
 
 /// The [security] table: DDS Security's files, each of which must exist
 /// (relative paths from the config's folder). All but `crl` are required.
-void readSecurity(const Reader& r, const toml::table& root, const std::function<std::string(const std::string&)>& resolve,
-                  transport::SecurityFiles& f) {
+void readSecurity(const Reader& r, const toml::table& root,
+                  const std::function<std::string(const std::string&)>& resolve, transport::SecurityFiles& f) {
   const toml::node* node = root.get("security");
   if (!node) return;
   const toml::table* t = node->as_table();

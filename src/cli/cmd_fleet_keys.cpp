@@ -29,7 +29,8 @@ int runFleetKeys(fleet::FleetRequest r) {
   if (done.new_ca)
     std::cout << "\nNew fleet CA in " << r.out << ": keep ca.key on this machine only; it signs every robot's keys.\n";
   if (!r.agents.empty()) {
-    std::cout << "\nCopy " << r.out << "/<agent>/ onto each robot (e.g. to /etc/tomomap/keys/) and add to its config:\n\n"
+    std::cout << "\nCopy " << r.out
+              << "/<agent>/ onto each robot (e.g. to /etc/tomomap/keys/) and add to its config:\n\n"
               << fleet::securityConfig("/etc/tomomap/keys", !r.revoke.empty());
   }
   if (!r.revoke.empty())

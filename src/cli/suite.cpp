@@ -1,9 +1,8 @@
 #include "suite.hpp"
 
-#include <algorithm>
-
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <set>
 

@@ -22,7 +22,7 @@ struct SuiteSynth {
   std::vector<int64_t> seeds{1};
   std::vector<std::string> noise{"low"};
   double scale = 1.0;
-  double grid = 0;  ///< grid size to match at [m]; 0 = the world's own
+  double grid = 0;                   ///< grid size to match at [m]; 0 = the world's own
   std::vector<std::string> methods;  ///< methods for these pairs (a subset of the suite's); empty: the suite's
 };
 

@@ -15,7 +15,8 @@ std::string governanceXml() {
      xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_governance.xsd">
   <domain_access_rules>
     <domain_rule>
-      )") + kDomains + R"(
+      )") +
+         kDomains + R"(
       <allow_unauthenticated_participants>false</allow_unauthenticated_participants>
       <enable_join_access_control>true</enable_join_access_control>
       <discovery_protection_kind>ENCRYPT</discovery_protection_kind>
@@ -62,7 +63,8 @@ std::string permissionsXml(const std::string& agent, const std::string& subject,
          not_after + R"(</not_after>
       </validity>
       <allow_rule>
-        )" + kDomains +
+        )" +
+         kDomains +
          R"(
         <publish>)" +
          topics + R"(</publish>

@@ -18,8 +18,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kCaKey = "ca.key";              ///< the CA's private key: never leaves the operator
-constexpr const char* kRevoked = "revoked.txt";       ///< serials revoked so far, one per line
+constexpr const char* kCaKey = "ca.key";         ///< the CA's private key: never leaves the operator
+constexpr const char* kRevoked = "revoked.txt";  ///< serials revoked so far, one per line
 constexpr const char* kCaName = "tomomap fleet CA";
 
 std::string utc(std::time_t t) {

@@ -117,8 +117,8 @@ Cert newCa(const Key& key, const std::string& common_name, const std::string& or
   return cert;
 }
 
-Cert issue(const Key& key, const std::string& common_name, const std::string& org, const Cert& ca,
-           const Key& ca_key, int days) {
+Cert issue(const Key& key, const std::string& common_name, const std::string& org, const Cert& ca, const Key& ca_key,
+           int days) {
   Cert cert = newCert(key, common_name, org, days);
   check(X509_set_issuer_name(cert.get(), X509_get_subject_name(ca.get())), "cannot set the issuer");
   addExtension(cert.get(), ca.get(), NID_basic_constraints, "critical,CA:FALSE");

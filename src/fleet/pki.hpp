@@ -29,8 +29,8 @@ Cert newCa(const Key& key, const std::string& common_name, const std::string& or
 
 /// A certificate for `key` issued by the CA, subject "CN=<common_name>,O=<org>".
 /// Serial numbers are random (128 bits), so a revocation names one certificate.
-Cert issue(const Key& key, const std::string& common_name, const std::string& org, const Cert& ca,
-           const Key& ca_key, int days);
+Cert issue(const Key& key, const std::string& common_name, const std::string& org, const Cert& ca, const Key& ca_key,
+           int days);
 
 /// Subject in RFC 2253 form ("CN=alpha,O=tomomap fleet"), as DDS permissions name it.
 std::string subject(const Cert& cert);

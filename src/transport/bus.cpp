@@ -1,8 +1,6 @@
 #include "bus.hpp"
 
 #include <algorithm>
-#include <map>
-#include <mutex>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
@@ -12,6 +10,8 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <map>
+#include <mutex>
 #include <stdexcept>
 
 #include "senders.hpp"

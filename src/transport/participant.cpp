@@ -6,10 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/rtps/flowcontrol/FlowControllerDescriptor.hpp>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 
@@ -36,8 +36,8 @@ double controlShare(const TransportConfig& c) {
   // and a MAC on every heartbeat and acknowledgement: with 13 % for two
   // receivers a peak of 818 kbit/s of 800 was seen.
   constexpr double kBase = 0.05, kPerReceiver = 0.04, kSecure = 0.05, kMax = 0.5;
-  return std::min(kMax, kBase + kPerReceiver * static_cast<double>(receivers(c)) +
-                            (c.security.enabled() ? kSecure : 0.0));
+  return std::min(kMax,
+                  kBase + kPerReceiver * static_cast<double>(receivers(c)) + (c.security.enabled() ? kSecure : 0.0));
 }
 
 double streamKbps(const TransportConfig& c) {

@@ -24,10 +24,8 @@ Binding bindParticipant(const std::string& participant_name, const std::optional
   const std::string agent = participant_name.substr(prefix.size());
   if (!cert_subject) return {agent, ""};
   const auto cn = commonName(*cert_subject);
-  if (!cn)
-    return {std::nullopt, "it names itself " + agent + " but its certificate (" + *cert_subject + ") has no CN"};
-  if (*cn != agent)
-    return {std::nullopt, "it names itself " + agent + " but is authenticated as " + *cn};
+  if (!cn) return {std::nullopt, "it names itself " + agent + " but its certificate (" + *cert_subject + ") has no CN"};
+  if (*cn != agent) return {std::nullopt, "it names itself " + agent + " but is authenticated as " + *cn};
   return {agent, ""};
 }
 

@@ -49,8 +49,8 @@ struct Intruder {
 
 transport::SecurityFiles robotFiles(const std::string& dir) {
   using F = fleet::RobotFiles;
-  return {dir + "/" + F::ca, dir + "/" + F::certificate, dir + "/" + F::private_key, dir + "/" + F::governance,
-          dir + "/" + F::permissions, ""};
+  return {dir + "/" + F::ca,         dir + "/" + F::certificate, dir + "/" + F::private_key,
+          dir + "/" + F::governance, dir + "/" + F::permissions, ""};
 }
 
 size_t statusCount(const Fleet& fleet, const std::string& id, const std::string& key) {
@@ -70,7 +70,8 @@ TEST(Identity, AnEstimateInAnotherAgentsNameIsDroppedAndCounted) {
 
   // Without security a participant's name is its word: mallory says who she
   // is, then signs an estimate with alpha's name (the versions are public).
-  Intruder mallory("mallory", fleet.port(10), {{"alpha", "127.0.0.1", fleet.port(0)}, {"bravo", "127.0.0.1", fleet.port(1)}});
+  Intruder mallory("mallory", fleet.port(10),
+                   {{"alpha", "127.0.0.1", fleet.port(0)}, {"bravo", "127.0.0.1", fleet.port(1)}});
   mallory.forge(real, "alpha");
   EXPECT_TRUE(Fleet::waitFor([&] { return statusCount(fleet, "bravo", "dropped_impostor_samples") > 0; }, 60s))
       << fleet.readJson("bravo", "status.json").dump(2);
@@ -114,9 +115,11 @@ TEST(Security, ASecureFleetAgreesAndNeitherStrangersNorLiarsChangeIt) {
   EXPECT_TRUE(Fleet::waitFor([&] { return charlie.peers_up >= 2; }, 60s)) << "charlie authenticates";
   for (const std::string id : {"alpha", "bravo"}) {
     EXPECT_TRUE(Fleet::waitFor([&] { return statusCount(fleet, id, "refused_participants") > 0; }, 60s))
-        << id << " refuses the participant of charlie that names itself alpha\n" << fleet.log(id);
+        << id << " refuses the participant of charlie that names itself alpha\n"
+        << fleet.log(id);
     EXPECT_TRUE(Fleet::waitFor([&] { return statusCount(fleet, id, "dropped_impostor_samples") > 0; }, 60s))
-        << id << " drops charlie's estimate in alpha's name\n" << fleet.log(id);
+        << id << " drops charlie's estimate in alpha's name\n"
+        << fleet.log(id);
   }
   EXPECT_NE(fleet.log("bravo").find("authenticated as charlie"), std::string::npos) << fleet.log("bravo");
   // The stranger started first and had as long as the others: it never got in.
@@ -256,11 +259,10 @@ TEST(Identity, AHundredThousandFuzzedSamplesCrashNothingAndLeaveMemoryFlat) {
   const auto [rss_after, peak] = memoryKb(fleet.pid("alpha"));
   EXPECT_LT(rss_after - rss_before, 64 * 1024) << "RSS " << rss_before << " -> " << rss_after << " kB";
   std::cerr << "alpha RSS " << rss_before << " kB before, " << rss_after << " kB after " << kSamples
-            << " fuzzed samples; peak " << peak << " kB; rejected "
-            << statusCount(fleet, "alpha", "rejected_samples") << "\n";
+            << " fuzzed samples; peak " << peak << " kB; rejected " << statusCount(fleet, "alpha", "rejected_samples")
+            << "\n";
   EXPECT_TRUE(fleet.transforms("alpha").empty()) << "nothing stored from fuzz";
-  EXPECT_LE(countOf(fleet.log("alpha"), "rejected"), 5u) << "one line, then a summary a minute\n"
-                                                          << fleet.log("alpha");
+  EXPECT_LE(countOf(fleet.log("alpha"), "rejected"), 5u) << "one line, then a summary a minute\n" << fleet.log("alpha");
   fleet.kill("alpha", SIGTERM);
   const auto code = fleet.waitExit("alpha", 2000ms);
   ASSERT_TRUE(code.has_value()) << "stops within 2 s";

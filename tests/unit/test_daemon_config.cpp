@@ -112,7 +112,7 @@ TEST(DaemonConfig, EveryKeyInTheReferenceIsOneTheDaemonReads) {
     if (!std::regex_search(line, m, row)) continue;
     ++rows;
     const std::string prefix = m[1].str();
-    const std::string table = !m[1].matched                                ? ""
+    const std::string table = !m[1].matched                                  ? ""
                               : prefix.find("peer") != std::string::npos     ? "peer."
                               : prefix.find("security") != std::string::npos ? "security."
                                                                              : "match.";
@@ -144,7 +144,8 @@ TEST(DaemonConfig, EveryShippedConfigLoads) {
     }
   }
   EXPECT_GE(n, 7u);
-  EXPECT_TRUE(loadConfig(dir / "config/local-3-agents/alpha.toml").transport.security.enabled()) << "the demo is secure";
+  EXPECT_TRUE(loadConfig(dir / "config/local-3-agents/alpha.toml").transport.security.enabled())
+      << "the demo is secure";
 }
 
 TEST(DaemonConfig, SecurityFilesMustExistAndBeComplete) {
