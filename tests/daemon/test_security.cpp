@@ -1,6 +1,7 @@
 // Who may speak for an agent. Real daemons, and an intruder that is a real
 // Fast DDS participant in this test process, forging estimates on the wire.
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <atomic>
 #include <cmath>
@@ -11,6 +12,8 @@
 #include "fleet/fleet_keys.hpp"
 #include "transport/bus.hpp"
 #include "transport/estimate_wire.hpp"
+#include "transport/map_offer.hpp"
+#include "transport/slice_encoding.hpp"
 
 using namespace tomomap;
 using namespace tomomap::test;
@@ -263,6 +266,70 @@ TEST(Identity, AHundredThousandFuzzedSamplesCrashNothingAndLeaveMemoryFlat) {
             << "\n";
   EXPECT_TRUE(fleet.transforms("alpha").empty()) << "nothing stored from fuzz";
   EXPECT_LE(countOf(fleet.log("alpha"), "rejected"), 5u) << "one line, then a summary a minute\n" << fleet.log("alpha");
+  fleet.kill("alpha", SIGTERM);
+  const auto code = fleet.waitExit("alpha", 2000ms);
+  ASSERT_TRUE(code.has_value()) << "stops within 2 s";
+  EXPECT_EQ(*code, 0);
+}
+
+TEST(Identity, AnOccupancyBombInAPeersNameStaysWithinTheMemoryBudget) {
+  // The bomb that once drove a daemon from 48 MB to 908 MB: an 8192 x 8192
+  // raster, 4 slices, every cell occupied (8 kB deflated per slice, 268 MB
+  // as a cell list each). A valid announcement in bravo's name, whose daemon
+  // never starts, so only the memory budget (256 MB by default) stands.
+  TempDir dir;
+  ASSERT_EQ(runTomomap("synth -o " + (dir / "world") + " -n 1 --noise low -s 3 --scale 0.5").exit_code, 0);
+  Fleet fleet(dir);
+  const std::vector<AgentSpec> agents{{"alpha", dir / "world/map_0.pcd"}, {"bravo", dir / "absent.pcd"}};
+  fleet.start(agents[0], agents);
+  ASSERT_TRUE(Fleet::waitFor([&] { return fleet.log("alpha").find("ready:") != std::string::npos; }, 60s));
+  Intruder bomber("bravo", fleet.port(10), {{"alpha", "127.0.0.1", fleet.port(0)}});
+
+  constexpr int kSide = 8192, kSlices = 4;
+  std::vector<uint8_t> raster(transport::rasterBytes(kSide, kSide), 0xff);
+  uLongf size = compressBound(static_cast<uLong>(raster.size()));
+  std::vector<uint8_t> full(size);
+  ASSERT_EQ(compress2(full.data(), &size, raster.data(), static_cast<uLong>(raster.size()), 9), Z_OK);
+  full.resize(size);
+  wire::MapAnnouncement a;
+  a.agent("bravo");
+  a.grid(0.05);
+  a.width(kSide);
+  a.height(kSide);
+  a.slice_count(kSlices);
+  a.raw_bytes(1u << 30);
+  a.features().max_features(1000);
+  a.features().fast_threshold(20);
+  a.features().pad(16);
+  for (int i = 0; i < kSlices; ++i) {
+    wire::SliceEntry e;
+    e.slice(i);
+    e.parts(1);
+    e.bytes(static_cast<uint32_t>(full.size()));
+    e.crc32(transport::crcOf(full));
+    a.slices().push_back(e);
+  }
+  a.version(transport::mapVersion(a));
+  ASSERT_FALSE(transport::validate(a)) << transport::validate(a).text();
+  bomber.bus->publish(a);
+  for (int i = 0; i < kSlices; ++i) {
+    wire::SliceFeatures s;
+    s.agent("bravo");
+    s.version(a.version());
+    s.slice(i);
+    s.part(0);
+    s.parts(1);
+    s.encoding(wire::SliceEncoding::OCCUPANCY);
+    s.occupancy(full);
+    bomber.bus->publish(s);
+  }
+  EXPECT_TRUE(Fleet::waitFor(
+      [&] { return fleet.log("alpha").find("more memory than peer_memory_mb allows") != std::string::npos; }, 120s))
+      << fleet.log("alpha");
+  const auto [rss, peak] = memoryKb(fleet.pid("alpha"));
+  std::cerr << "alpha under the bomb: RSS " << rss << " kB, peak " << peak << " kB\n";
+  EXPECT_LT(peak, 256 * 1024) << "below the budget, and far below the 908 MB the bomb once took";
+  EXPECT_EQ(fleet.log("alpha").find("received the map of bravo"), std::string::npos);
   fleet.kill("alpha", SIGTERM);
   const auto code = fleet.waitExit("alpha", 2000ms);
   ASSERT_TRUE(code.has_value()) << "stops within 2 s";
