@@ -26,8 +26,7 @@ OwnMap describeOwnMap(const Config& config) {
   const auto t0 = Clock::now();
   OwnMap own;
   auto features = [&] {
-    const Points map = loadMap(config.map);  // dropped once described
-    validateMap(map, config.map);
+    const Points map = loadMap(config.map, &own.nonfinite);  // dropped once described
     return std::make_shared<MapFeatures>(describeMap(map, config.match, nullptr, &own.cells));
   }();
   own.offer = transport::makeOffer(
@@ -39,6 +38,9 @@ OwnMap describeOwnMap(const Config& config) {
 }
 
 void Agent::installOwnMap(OwnMap own) {
+  if (own.nonfinite > 0)
+    log_.warning(config_.map + ": dropped " + std::to_string(own.nonfinite) +
+                 " points with NaN or infinite coordinates");
   const bool update = own_features_ != nullptr;
   const uint64_t before = sender_.version();
   sender_.setOffer(std::move(own.offer));

@@ -36,8 +36,9 @@ struct Signals {
 struct OwnMap {
   std::shared_ptr<const MapFeatures> features;
   transport::MapOffer offer;
-  size_t cells = 0;    ///< voxel-filtered points
-  double seconds = 0;  ///< time taken to describe it
+  size_t cells = 0;      ///< voxel-filtered points
+  size_t nonfinite = 0;  ///< points with NaN or infinite coordinates, dropped
+  double seconds = 0;    ///< time taken to describe it
 };
 
 /// Loads, describes and encodes the map the config names. Throws InputError

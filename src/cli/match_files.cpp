@@ -16,8 +16,12 @@ MatchedFiles matchFiles(const MatchFilesOptions& o) {
   if (!o.gt_source.empty()) m.P_source = loadPoseFile(o.gt_source);
   StageTimings timings;
   auto describe = [&](const std::string& path, const char* role) {
-    const Points map = loadMap(path);
+    size_t nonfinite = 0;
+    const Points map = loadMap(path, &nonfinite);
     m.sizes[std::string(role) + "_points"] = map.size();
+    m.sizes[std::string(role) + "_nonfinite_dropped"] = nonfinite;
+    if (nonfinite > 0)
+      std::cerr << "warning: " << path << ": dropped " << nonfinite << " points with NaN or infinite coordinates\n";
     if (!o.quiet) std::cout << role << " " << path << " (" << map.size() << " points)\n";
     return describeMap(map, o.params, &timings);
   };

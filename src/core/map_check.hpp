@@ -12,4 +12,9 @@ constexpr size_t kMinMapPoints = 100;
 /// Throws InputError (naming `what`) for an empty, too small or non-finite map.
 void validateMap(const Points& points, const std::string& what);
 
+/// Removes points with a NaN or infinite coordinate (organised clouds from
+/// PCL-based SLAM carry them: a normal map, not a broken one); returns how
+/// many. The order of the rest is kept.
+size_t dropNonFinite(Points& points);
+
 }  // namespace tomomap

@@ -105,7 +105,7 @@ Points loadXyz(const std::string& path) {
 
 }  // namespace
 
-Points loadMap(const std::string& path) {
+Points loadMap(const std::string& path, size_t* nonfinite) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(path + ": no such file");
   if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a directory, not a map file");
@@ -121,6 +121,12 @@ Points loadMap(const std::string& path) {
     points = loadXyz(path);
   else
     throw InputError(path + ": unknown map format '" + ext + "' (use .pcd, .ply, .xyz or .txt)");
+  const size_t read = points.size(), dropped = dropNonFinite(points);
+  if (nonfinite) *nonfinite = dropped;
+  if (dropped > 0 && points.size() < kMinMapPoints)
+    throw InputError(path + ": only " + std::to_string(points.size()) + " of " + std::to_string(read) +
+                     " points are finite (the rest NaN or infinite); at least " + std::to_string(kMinMapPoints) +
+                     " are needed");
   validateMap(points, path);
   return points;
 }

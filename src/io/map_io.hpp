@@ -14,9 +14,11 @@ constexpr size_t kPcdHeaderBytes = 190;
 constexpr uint64_t binaryPcdBytes(size_t points) { return kPcdBytesPerPoint * points + kPcdHeaderBytes; }
 
 /// Loads a map: .pcd (ascii, binary, binary_compressed), .ply, or .xyz/.txt
-/// (one "x y z" per line, '#' comments). Throws InputError naming the file and
-/// the problem for a missing, unreadable, corrupt, empty or non-finite map.
-Points loadMap(const std::string& path);
+/// (one "x y z" per line, '#' comments). Points with a NaN or infinite
+/// coordinate are dropped and counted in `*nonfinite`. Throws InputError
+/// naming the file and the problem for a missing, unreadable, corrupt or empty
+/// map, or one with fewer than kMinMapPoints finite points.
+Points loadMap(const std::string& path, size_t* nonfinite = nullptr);
 
 /// Writes a binary_compressed PCD (x y z float). Throws InputError on failure.
 void savePcd(const std::string& path, const Points& points);

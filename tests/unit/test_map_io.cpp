@@ -80,17 +80,33 @@ TEST(MapIo, TinyMapIsRejected) {
   EXPECT_NE(errorOf([&] { loadMap(dir / "ten.pcd"); }).find("only 10 points"), std::string::npos);
 }
 
-TEST(MapIo, NonFinitePointsAreRejected) {
+TEST(MapIo, NonFinitePointsAreDroppedAndCounted) {
   TempDir dir;
   std::string xyz;
   for (const auto& q : grid(200))
     xyz += std::to_string(q.x()) + " " + std::to_string(q.y()) + " " + std::to_string(q.z()) + "\n";
   write(dir / "nan.xyz", xyz + "nan 1 2\ninf 0 0\n");
-  EXPECT_NE(errorOf([&] { loadMap(dir / "nan.xyz"); }).find("2 of 202 points are NaN or infinite"), std::string::npos);
+  size_t dropped = 0;
+  EXPECT_EQ(loadMap(dir / "nan.xyz", &dropped).size(), 200u);
+  EXPECT_EQ(dropped, 2u);
   Points p = grid(200);
   p[7].y() = std::numeric_limits<float>::quiet_NaN();
   savePcd(dir / "nan.pcd", p);
-  EXPECT_NE(errorOf([&] { loadMap(dir / "nan.pcd"); }).find("NaN"), std::string::npos);
+  const Points back = loadMap(dir / "nan.pcd", &dropped);
+  EXPECT_EQ(back.size(), 199u);
+  EXPECT_EQ(dropped, 1u);
+  EXPECT_EQ(back[7], p[8]) << "the rest keep their order";
+}
+
+TEST(MapIo, AMapWithTooFewFinitePointsIsRefused) {
+  TempDir dir;
+  std::string xyz;
+  for (const auto& q : grid(50))
+    xyz += std::to_string(q.x()) + " " + std::to_string(q.y()) + " " + std::to_string(q.z()) + "\n";
+  for (int i = 0; i < 100; ++i) xyz += "nan nan nan\n";
+  write(dir / "nan.xyz", xyz);
+  EXPECT_NE(errorOf([&] { loadMap(dir / "nan.xyz"); }).find("only 50 of 150 points are finite"), std::string::npos)
+      << errorOf([&] { loadMap(dir / "nan.xyz"); });
 }
 
 TEST(MapIo, TruncatedAndCorruptPcdAreRejected) {
