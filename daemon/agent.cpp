@@ -41,6 +41,9 @@ void Agent::installOwnMap(OwnMap own) {
   if (own.nonfinite > 0)
     log_.warning(config_.map + ": dropped " + std::to_string(own.nonfinite) +
                  " points with NaN or infinite coordinates");
+  if (own.features->occupancy.stray > 0)
+    log_.warning(config_.map + ": left out " + std::to_string(own.features->occupancy.stray) +
+                 " stray voxels far from the rest of the map");
   const bool update = own_features_ != nullptr;
   const uint64_t before = sender_.version();
   sender_.setOffer(std::move(own.offer));

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "core/map_bounds.hpp"
 #include "io/map_io.hpp"
 #include "progress.hpp"
 
@@ -23,7 +24,12 @@ MatchedFiles matchFiles(const MatchFilesOptions& o) {
     if (nonfinite > 0)
       std::cerr << "warning: " << path << ": dropped " << nonfinite << " points with NaN or infinite coordinates\n";
     if (!o.quiet) std::cout << role << " " << path << " (" << map.size() << " points)\n";
-    return describeMap(map, o.params, &timings);
+    MapFeatures f = describeMap(map, o.params, &timings);
+    m.sizes[std::string(role) + "_stray_voxels"] = f.occupancy.stray;
+    if (f.occupancy.stray > 0)
+      std::cerr << "warning: " << path << ": left out " << f.occupancy.stray
+                << " stray voxels far from the rest of the map (a gap of " << kStrayGap << " m or more)\n";
+    return f;
   };
   m.target = describe(o.target, "target");
   m.source = describe(o.source, "source");

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "map_bounds.hpp"
+
 namespace tomomap {
 
 cv::Mat SliceStack::image(int k, int pad) const {
@@ -16,11 +18,9 @@ SliceStack makeSlices(const Points& points, double cell) {
   SliceStack stack;
   if (points.empty()) return stack;
 
-  Eigen::Vector3f lo = points.front(), hi = points.front();
-  for (const auto& p : points) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
+  const MapBounds bounds = robustBounds(points);
+  const Eigen::Vector3f lo = bounds.lo, hi = bounds.hi;
+  stack.stray = bounds.outside;
   SliceGrid& g = stack.grid;
   g.cell = cell;
   g.x_min = lo.x();
@@ -39,6 +39,7 @@ SliceStack makeSlices(const Points& points, double cell) {
   auto& cells = stack.cells;
   cells.resize(static_cast<size_t>(n));
   for (const auto& p : points) {
+    if (bounds.outside > 0 && !bounds.contains(p)) continue;
     const int k = std::clamp(g.sliceIndex(p.z()), 0, static_cast<int>(n) - 1);
     const int u = std::min(static_cast<int>((p.x() - g.x_min) / cell), g.width - 1);
     const int v = std::min(static_cast<int>((p.y() - g.y_min) / cell), g.height - 1);

@@ -30,6 +30,7 @@ struct SliceGrid {
 struct SliceStack {
   SliceGrid grid;
   std::vector<std::vector<uint32_t>> cells;  ///< per slice; empty = too sparse to describe
+  size_t stray = 0;                          ///< points left out as stray returns (map_bounds.hpp)
 
   int size() const { return static_cast<int>(cells.size()); }
   /// Renders slice k as a CV_8U image, 255 = occupied, with `pad` empty pixels
@@ -41,7 +42,8 @@ struct SliceStack {
 /// instead of allocating gigabytes.
 constexpr int kMaxImageSide = 16384;
 
-/// Slices `points` (already voxel-filtered at `cell`). Slices with fewer
+/// Slices `points` (already voxel-filtered at `cell`) within their robust
+/// bounds (stray returns left out and counted). Slices with fewer
 /// occupied cells than (width + height) / 2 are kept empty (too sparse for ORB);
 /// empty slices at the bottom and top are trimmed. Throws InputError if the
 /// raster would exceed kMaxImageSide.

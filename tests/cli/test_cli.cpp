@@ -77,19 +77,42 @@ TEST(Cli, NonFinitePointsAreDroppedCountedAndChangeNothing) {
                i % 2 ? Eigen::Vector3f(nan, nan, nan) : Eigen::Vector3f(1, inf, 0));
   savePcd(dir / "with-nan.pcd", map);
   savePcd(dir / "clean.pcd", clean);
-  const auto with = runTomomap("match --json " + (dir / "with.json") + " " + demo("demo-pcd1.pcd") + " " +
-                               (dir / "with-nan.pcd"));
+  const auto with =
+      runTomomap("match --json " + (dir / "with.json") + " " + demo("demo-pcd1.pcd") + " " + (dir / "with-nan.pcd"));
   ASSERT_EQ(with.exit_code, 0) << with.output;
-  EXPECT_NE(with.output.find("dropped 100 points with NaN or infinite coordinates"), std::string::npos)
-      << with.output;
-  const auto without = runTomomap("match --json " + (dir / "without.json") + " " + demo("demo-pcd1.pcd") + " " +
-                                  (dir / "clean.pcd"));
+  EXPECT_NE(with.output.find("dropped 100 points with NaN or infinite coordinates"), std::string::npos) << with.output;
+  const auto without =
+      runTomomap("match --json " + (dir / "without.json") + " " + demo("demo-pcd1.pcd") + " " + (dir / "clean.pcd"));
   ASSERT_EQ(without.exit_code, 0) << without.output;
   const auto a = nlohmann::json::parse(std::ifstream(dir / "with.json"));
   const auto b = nlohmann::json::parse(std::ifstream(dir / "without.json"));
   EXPECT_EQ(a["T_target_source"], b["T_target_source"]) << "the same transform as without them";
   EXPECT_EQ(a["source_nonfinite_dropped"], 100);
   EXPECT_EQ(a["source_points"], clean.size());
+}
+
+TEST(Cli, AStrayPointFarAwayChangesNothing) {
+  // One stray return 100 m from a room-sized map once stretched the raster
+  // twenty-fold and left no slice dense enough to match (exit 1).
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  Points map = loadMap(demo("demo-pcd2.pcd"));
+  savePcd(dir / "clean.pcd", map);
+  map.emplace_back(map.front() + Eigen::Vector3f(100, 0, 0));
+  savePcd(dir / "stray.pcd", map);
+  const auto with =
+      runTomomap("match --json " + (dir / "with.json") + " " + demo("demo-pcd1.pcd") + " " + (dir / "stray.pcd"));
+  ASSERT_EQ(with.exit_code, 0) << with.output;
+  EXPECT_NE(with.output.find("left out 1 stray voxels"), std::string::npos) << with.output;
+  ASSERT_EQ(
+      runTomomap("match --json " + (dir / "without.json") + " " + demo("demo-pcd1.pcd") + " " + (dir / "clean.pcd"))
+          .exit_code,
+      0);
+  const auto a = nlohmann::json::parse(std::ifstream(dir / "with.json"));
+  const auto b = nlohmann::json::parse(std::ifstream(dir / "without.json"));
+  EXPECT_EQ(a["T_target_source"], b["T_target_source"]) << "the same transform as without it";
+  EXPECT_EQ(a["source_stray_voxels"], 1);
+  EXPECT_EQ(b["source_stray_voxels"], 0);
 }
 
 TEST(Cli, EmptyTinyNanTruncatedAndCorruptMaps) {
