@@ -32,6 +32,12 @@ void judge(MatchResult& r, const MatchParams& params) {
   if (r.support < params.min_support)
     r.reason =
         "only " + std::to_string(r.support) + " slice pairs agree (need " + std::to_string(params.min_support) + ")";
+  else if (r.runner_up_support >= r.support)
+    // Another height offset, more than a slice away, explains the maps as well:
+    // a guess between two answers is not a result. (A margin above a tie
+    // wants right and wrong matches' support ratios measured first.)
+    r.reason = "ambiguous: another height offset has as much support (" + std::to_string(r.support) + " vs " +
+               std::to_string(r.runner_up_support) + " slice pairs)";
   else if (r.inliers < static_cast<size_t>(params.min_inliers))
     r.reason = "only " + std::to_string(r.inliers) + " inlier correspondences (need " +
                std::to_string(params.min_inliers) + ")";

@@ -102,3 +102,16 @@ TEST(Matcher, TheSlicePairTableKeepsExactlyTheMatchesOfEachPair) {
     }
   EXPECT_GT(with_estimate, 0u);
 }
+
+TEST(Matcher, ATieBetweenTwoHeightsIsNoReliableMatch) {
+  // Two identical floors: the room fits either as well, and a pick between
+  // them would be a coin flip passed off as a result.
+  REQUIRE_DEMO_ROOM();
+  const auto demo = test::loadDemoPair();
+  Points two_floors = demo.map1;
+  for (const auto& p : demo.map1) two_floors.push_back(p + Eigen::Vector3f(0, 0, 4.0f));
+  const MatchResult r = matchMaps(two_floors, demo.map2, MatchParams{});
+  EXPECT_FALSE(r.reliable) << "support " << r.support << ", runner-up " << r.runner_up_support;
+  EXPECT_NE(r.reason.find("ambiguous"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.support, r.runner_up_support);
+}
