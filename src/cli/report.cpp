@@ -82,6 +82,7 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
   j["quality"] = {{"support", r.support},
                   {"height_offset_slices", r.height_offset},
                   {"runner_up_support", r.runner_up_support},
+                  {"runner_up_offset_slices", r.runner_up_offset},
                   {"inliers", r.inliers},
                   {"inlier_spread", {r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z()}}};
   j["slices"] = {{"target", r.target_slices},

@@ -41,8 +41,10 @@ OffsetChoice pickOffset(const std::vector<OffsetScore>& scores) {
     return x.inlier_sum < y.inlier_sum;
   });
   for (const auto& s : scores)
-    if (std::abs(s.offset - c.best->offset) > 1)
-      c.runner_up_support = std::max(c.runner_up_support, static_cast<int>(s.consensus.support()));
+    if (std::abs(s.offset - c.best->offset) > 1 && static_cast<int>(s.consensus.support()) > c.runner_up_support) {
+      c.runner_up_support = static_cast<int>(s.consensus.support());
+      c.runner_up_offset = s.offset;
+    }
   return c;
 }
 

@@ -22,6 +22,7 @@ std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeat
 struct OffsetChoice {
   const OffsetScore* best = nullptr;  ///< most support, then most inliers; null when there are no scores
   int runner_up_support = 0;          ///< best support more than one step away from the winner
+  int runner_up_offset = 0;           ///< its height offset [slices]
 };
 
 OffsetChoice pickOffset(const std::vector<OffsetScore>& scores);

@@ -35,6 +35,7 @@ struct MatchResult {
 
   int support = 0;                                          ///< agreeing slice pairs at the winning height offset
   int runner_up_support = 0;                                ///< best support more than one step away from the winner
+  int runner_up_offset = 0;                                 ///< its height offset [slices]
   int height_offset = 0;                                    ///< winning target slice index - source slice index
   std::vector<SupportingPair> supporters;                   ///< the slice pairs behind `support`, most inliers first
   size_t inliers = 0;                                       ///< feature correspondences consistent with the result
