@@ -20,4 +20,8 @@ BUILD_DIR=build-asan TARGETS="unit_tests daemon_tests tomomapd tomomap" \
 # when a participant is deleted; that is in the library, not in tomomap.
 export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:new_delete_type_mismatch=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-(cd build-asan && ctest --output-on-failure -j"$jobs" --timeout 1200 -L "unit|daemon")
+(cd build-asan && ctest --output-on-failure -j"$jobs" --timeout 1200 -L unit)
+# The daemon tests run secure participants: Fast DDS's own leaks there are
+# suppressed (the file says which and why).
+(cd build-asan && LSAN_OPTIONS="suppressions=$PWD/../tests/lsan-fastdds-security.supp" \
+  ctest --output-on-failure -j"$jobs" --timeout 1200 -L daemon)

@@ -21,6 +21,14 @@ using namespace std::chrono_literals;
 
 namespace {
 
+/// Memory figures mean nothing under AddressSanitizer (shadow memory, a
+/// quarantine of freed blocks): there the memory bounds are not checked.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kMeasuresMemory = false;
+#else
+constexpr bool kMeasuresMemory = true;
+#endif
+
 /// A participant of our own making that joins the fleet's peers as `name`.
 struct Intruder {
   std::atomic<int> peers_up{0};
@@ -260,7 +268,9 @@ TEST(Identity, AHundredThousandFuzzedSamplesCrashNothingAndLeaveMemoryFlat) {
       << fleet.readJson("alpha", "status.json").dump(2);
   EXPECT_FALSE(fleet.waitExit("alpha", 100ms).has_value()) << "alive\n" << fleet.log("alpha");
   const auto [rss_after, peak] = memoryKb(fleet.pid("alpha"));
-  EXPECT_LT(rss_after - rss_before, 64 * 1024) << "RSS " << rss_before << " -> " << rss_after << " kB";
+  if (kMeasuresMemory) {
+    EXPECT_LT(rss_after - rss_before, 64 * 1024) << "RSS " << rss_before << " -> " << rss_after << " kB";
+  }
   std::cerr << "alpha RSS " << rss_before << " kB before, " << rss_after << " kB after " << kSamples
             << " fuzzed samples; peak " << peak << " kB; rejected " << statusCount(fleet, "alpha", "rejected_samples")
             << "\n";
@@ -328,7 +338,9 @@ TEST(Identity, AnOccupancyBombInAPeersNameStaysWithinTheMemoryBudget) {
       << fleet.log("alpha");
   const auto [rss, peak] = memoryKb(fleet.pid("alpha"));
   std::cerr << "alpha under the bomb: RSS " << rss << " kB, peak " << peak << " kB\n";
-  EXPECT_LT(peak, 256 * 1024) << "below the budget, and far below the 908 MB the bomb once took";
+  if (kMeasuresMemory) {
+    EXPECT_LT(peak, 256 * 1024) << "below the budget, and far below the 908 MB the bomb once took";
+  }
   EXPECT_EQ(fleet.log("alpha").find("received the map of bravo"), std::string::npos);
   fleet.kill("alpha", SIGTERM);
   const auto code = fleet.waitExit("alpha", 2000ms);
