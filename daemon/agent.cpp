@@ -92,7 +92,9 @@ void Agent::onImpostor(const std::string& claimed, const std::string& sender) {
 
 void Agent::onRefused(const std::string& participant, const std::string& why) {
   ++counters_.refused_participants;
-  if (auto line = rejections_.note(participant, "its participant speaks for no agent: " + why, Clock::now()))
+  // Keyed by name and reason: a stranger and an impostor can share a name
+  // (tomomapd/alpha), and each deserves its line.
+  if (auto line = rejections_.note(participant + " (" + why + ")", "its participant speaks for no agent", Clock::now()))
     log_.warning(*line);
 }
 
