@@ -29,10 +29,10 @@ int runFleetKeys(fleet::FleetRequest r) {
   if (done.new_ca)
     std::cout << "\nNew fleet CA in " << r.out << ": keep ca.key on this machine only; it signs every robot's keys.\n";
   if (!r.agents.empty()) {
-    std::cout << "\nCopy " << r.out
-              << "/<agent>/ onto each robot (e.g. to /etc/tomomap/keys/) and add to its config:\n\n"
-              << fleet::securityConfig("/etc/tomomap/keys", !r.revoke.empty())
-              << "\n(under systemd the service reads key.pem as a credential: docs/operations.md, \"A secure fleet\")\n";
+    std::cout
+        << "\nCopy " << r.out << "/<agent>/ onto each robot (e.g. to /etc/tomomap/keys/) and add to its config:\n\n"
+        << fleet::securityConfig("/etc/tomomap/keys", !r.revoke.empty())
+        << "\n(under systemd the service reads key.pem as a credential: docs/operations.md, \"A secure fleet\")\n";
   }
   if (!r.revoke.empty())
     std::cout << "\nRevoked " << r.revoke.size() << " robot(s): deploy crl.pem to every other robot, set `crl` in "

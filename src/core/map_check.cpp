@@ -20,7 +20,8 @@ void validateMap(const Points& points, const std::string& what) {
 }
 
 size_t dropNonFinite(Points& points) {
-  const auto kept = std::remove_if(points.begin(), points.end(), [](const Eigen::Vector3f& p) { return !p.allFinite(); });
+  const auto kept =
+      std::remove_if(points.begin(), points.end(), [](const Eigen::Vector3f& p) { return !p.allFinite(); });
   const auto dropped = static_cast<size_t>(points.end() - kept);
   points.erase(kept, points.end());
   return dropped;
