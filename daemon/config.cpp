@@ -110,16 +110,23 @@ std::string checkedId(const Reader& r, const toml::table& t, const std::string& 
   return id;
 }
 
+/// The optional table `[name]`, every key of it one of kKeys; null if absent.
+const toml::table* knownTable(const Reader& r, const toml::table& root, const std::string& name) {
+  const toml::node* node = root.get(name);
+  if (!node) return nullptr;
+  const toml::table* t = node->as_table();
+  if (!t) r.fail(*node, name, "must be a table ([" + name + "])");
+  for (const auto& [key, value] : *t)
+    if (std::find(kKeys.begin(), kKeys.end(), name + "." + std::string(key.str())) == kKeys.end())
+      r.fail(value, name + "." + std::string(key.str()), "unknown key (see docs/configuration.md)");
+  return t;
+}
+
 /// The [match] table: each key overrides one MatchParams field; absent keys
 /// keep the matcher's own defaults.
 void readMatch(const Reader& r, const toml::table& root, MatchParams& m) {
-  const toml::node* node = root.get("match");
-  if (!node) return;
-  const toml::table* t = node->as_table();
-  if (!t) r.fail(*node, "match", "must be a table ([match])");
-  for (const auto& [key, value] : *t)
-    if (std::find(kKeys.begin(), kKeys.end(), "match." + std::string(key.str())) == kKeys.end())
-      r.fail(value, "match." + std::string(key.str()), "unknown key (see docs/configuration.md)");
+  const toml::table* t = knownTable(r, root, "match");
+  if (!t) return;
   m.features.max_features = r.integer(*t, "max_features", m.features.max_features, 1, 10000);
   m.features.fast_threshold = r.integer(*t, "fast_threshold", m.features.fast_threshold, 1, 255);
   m.ransac_threshold_cells = r.number(*t, "ransac_threshold_cells", m.ransac_threshold_cells, 0.5, 50);
@@ -137,13 +144,8 @@ void readMatch(const Reader& r, const toml::table& root, MatchParams& m) {
 /// (relative paths from the config's folder). All but `crl` are required.
 void readSecurity(const Reader& r, const toml::table& root,
                   const std::function<std::string(const std::string&)>& resolve, transport::SecurityFiles& f) {
-  const toml::node* node = root.get("security");
-  if (!node) return;
-  const toml::table* t = node->as_table();
-  if (!t) r.fail(*node, "security", "must be a table ([security])");
-  for (const auto& [key, value] : *t)
-    if (std::find(kKeys.begin(), kKeys.end(), "security." + std::string(key.str())) == kKeys.end())
-      r.fail(value, "security." + std::string(key.str()), "unknown key (see docs/configuration.md)");
+  const toml::table* t = knownTable(r, root, "security");
+  if (!t) return;
   auto file = [&](const std::string& key, bool required) -> std::string {
     if (!required && !t->get(key)) return "";
     const std::string path = resolve(r.text(*t, key, std::nullopt));

@@ -31,16 +31,12 @@ std::vector<AgreedTransform> PairBoard::mapAnnounced(const std::string& agent, u
   std::vector<AgreedTransform> stored;
   for (auto it = pending_.begin(); it != pending_.end();) {
     const PairKey& key = it->first.first;
-    if (key.first != agent && key.second != agent) {
+    const bool decidable = (key.first == agent || key.second == agent) && versionOf(key.first) && versionOf(key.second);
+    if (!decidable) {
       ++it;
       continue;
     }
-    AgreedTransform t = it->second;
-    const bool settled = versionOf(key.first) && versionOf(key.second);
-    if (!settled) {
-      ++it;
-      continue;
-    }
+    AgreedTransform t = std::move(it->second);
     it = pending_.erase(it);
     if (estimateSeen(t) == Offer::Stored) stored.push_back(std::move(t));
   }

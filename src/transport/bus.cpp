@@ -23,8 +23,8 @@ using namespace eprosima::fastdds::dds;
 
 namespace {
 
-SenderDirectory::Prefix prefixOf(const eprosima::fastrtps::rtps::GuidPrefix_t& p) {
-  SenderDirectory::Prefix out{};
+ParticipantKey prefixOf(const eprosima::fastrtps::rtps::GuidPrefix_t& p) {
+  ParticipantKey out{};
   std::copy(std::begin(p.value), std::end(p.value), out.begin());
   return out;
 }
@@ -79,7 +79,7 @@ class ParticipantWatch : public DomainParticipantListener {
       std::unique_lock<std::mutex> lock(mutex_);
       const auto b = admission_.discovered(prefix, info.info.m_participantName.to_string(), subjectOf(info.info));
       lock.unlock();
-      apply(prefix, b, info.info.m_participantName.to_string());
+      apply(prefix, b);
     }
     if (info.status == S::REMOVED_PARTICIPANT || info.status == S::DROPPED_PARTICIPANT) {
       {
@@ -105,14 +105,14 @@ class ParticipantWatch : public DomainParticipantListener {
     }
     const auto b = admission_.authenticated(prefix);
     lock.unlock();
-    apply(prefix, b, "");
+    apply(prefix, b);
   }
 
  private:
-  void apply(const SenderDirectory::Prefix& prefix, const std::optional<Binding>& b, const std::string& name) {
+  void apply(const ParticipantKey& prefix, const std::optional<Binding>& b) {
     if (!b) return;
     if (!b->agent) {
-      if (refused_) refused_(name.empty() ? "a participant" : name, b->refusal);
+      if (refused_) refused_(b->participant, b->refusal);
       return;
     }
     senders_.bind(prefix, *b->agent);

@@ -13,8 +13,12 @@
 
 namespace tomomap::transport {
 
+/// A participant's GUID prefix: the key of everything below.
+using ParticipantKey = std::array<uint8_t, 12>;
+
 /// The agent a participant speaks for, or why it speaks for none.
 struct Binding {
+  std::string participant;  ///< its name
   std::optional<std::string> agent;
   std::string refusal;  ///< when there is no agent
 };
@@ -34,37 +38,35 @@ std::optional<std::string> commonName(const std::string& subject);
 /// succeeded. Without security, on discovery. Not thread-safe.
 class Admission {
  public:
-  using Prefix = std::array<uint8_t, 12>;
   explicit Admission(bool secure) : secure_(secure) {}
   /// The binding to make now, if any.
-  std::optional<Binding> discovered(const Prefix& p, const std::string& name, const std::string& subject);
-  std::optional<Binding> authenticated(const Prefix& p);
+  std::optional<Binding> discovered(const ParticipantKey& p, const std::string& name, const std::string& subject);
+  std::optional<Binding> authenticated(const ParticipantKey& p);
   /// A failed handshake: the name to report it under ("a participant" if unknown).
-  std::string failed(const Prefix& p);
-  void gone(const Prefix& p);
+  std::string failed(const ParticipantKey& p);
+  void gone(const ParticipantKey& p);
 
  private:
   struct Candidate {
     std::string name, subject;
     bool discovered = false, authenticated = false;
   };
-  std::optional<Binding> settle(const Prefix& p);
+  std::optional<Binding> settle(const ParticipantKey& p);
   const bool secure_;
-  std::map<Prefix, Candidate> candidates_;  ///< discovered or authenticated, not bound yet
+  std::map<ParticipantKey, Candidate> candidates_;  ///< discovered or authenticated, not bound yet
 };
 
 /// Participants known to speak for an agent, by GUID prefix (12 bytes).
 /// Written by discovery, read by every reader's listener: thread-safe.
 class SenderDirectory {
  public:
-  using Prefix = std::array<uint8_t, 12>;
-  void bind(const Prefix& participant, const std::string& agent);
-  void forget(const Prefix& participant);
-  std::optional<std::string> agentOf(const Prefix& participant) const;
+  void bind(const ParticipantKey& participant, const std::string& agent);
+  void forget(const ParticipantKey& participant);
+  std::optional<std::string> agentOf(const ParticipantKey& participant) const;
 
  private:
   mutable std::mutex mutex_;
-  std::map<Prefix, std::string> agents_;
+  std::map<ParticipantKey, std::string> agents_;
 };
 
 }  // namespace tomomap::transport

@@ -27,21 +27,22 @@ TEST(Senders, ASecureParticipantSpeaksOnlyForItsCertificatesName) {
   const Binding liar = bindParticipant("tomomapd/alpha", std::string("/O=tomomap fleet/CN=charlie"));
   EXPECT_FALSE(liar.agent);
   EXPECT_NE(liar.refusal.find("authenticated as charlie"), std::string::npos) << liar.refusal;
+  EXPECT_EQ(liar.participant, "tomomapd/alpha") << "a refusal names the participant, whichever event settled it";
   EXPECT_FALSE(bindParticipant("tomomapd/alpha", std::string("")).agent) << "no subject: no identity";
 }
 
 TEST(Senders, TheDirectoryForgetsAParticipantThatLeft) {
   SenderDirectory d;
-  const SenderDirectory::Prefix p{1, 2, 3};
+  const ParticipantKey p{1, 2, 3};
   d.bind(p, "alpha");
   EXPECT_EQ(d.agentOf(p), "alpha");
-  EXPECT_FALSE(d.agentOf(SenderDirectory::Prefix{9}).has_value());
+  EXPECT_FALSE(d.agentOf(ParticipantKey{9}).has_value());
   d.forget(p);
   EXPECT_FALSE(d.agentOf(p).has_value());
 }
 
 TEST(Senders, ASecureParticipantIsBoundOnceDiscoveredAndAuthenticatedInEitherOrder) {
-  const Admission::Prefix a{1}, b{2};
+  const ParticipantKey a{1}, b{2};
   Admission desk(/*secure=*/true);
   EXPECT_FALSE(desk.discovered(a, "tomomapd/alpha", "/O=f/CN=alpha")) << "discovery alone proves nothing";
   const auto bound = desk.authenticated(a);
@@ -54,7 +55,7 @@ TEST(Senders, ASecureParticipantIsBoundOnceDiscoveredAndAuthenticatedInEitherOrd
 TEST(Senders, AFailedHandshakeFollowedByASuccessfulOneStillBinds) {
   // Two peers' handshakes crossed: one failed, the next succeeded (seen with
   // three daemons started together; binding was lost for good before).
-  const Admission::Prefix a{1};
+  const ParticipantKey a{1};
   Admission desk(/*secure=*/true);
   EXPECT_FALSE(desk.discovered(a, "tomomapd/alpha", "/O=f/CN=alpha"));
   EXPECT_EQ(desk.failed(a), "tomomapd/alpha");
@@ -65,7 +66,7 @@ TEST(Senders, AFailedHandshakeFollowedByASuccessfulOneStillBinds) {
 
 TEST(Senders, APlainParticipantIsBoundOnDiscovery) {
   Admission desk(/*secure=*/false);
-  const auto bound = desk.discovered(Admission::Prefix{7}, "tomomapd/alpha", "");
+  const auto bound = desk.discovered(ParticipantKey{7}, "tomomapd/alpha", "");
   ASSERT_TRUE(bound);
   EXPECT_EQ(bound->agent, "alpha");
 }
