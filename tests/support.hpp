@@ -5,7 +5,9 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include "io/map_io.hpp"
@@ -18,6 +20,21 @@ inline bool haveDemoRoom() { return std::filesystem::exists(demoRoom() + "/demo-
 #define REQUIRE_DEMO_ROOM()             \
   if (!::tomomap::test::haveDemoRoom()) \
   GTEST_SKIP() << "demo-room data set not found at " << ::tomomap::test::demoRoom()
+
+/// A whole file as text; empty if it cannot be read.
+inline std::string readText(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Occurrences of `what` in `text` (e.g. log lines with a word).
+inline size_t countOf(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
 
 /// A fresh directory removed when the object goes out of scope.
 struct TempDir {

@@ -2,6 +2,7 @@
 // Real tomomapd processes on loopback for the multi-process tests: configs
 // written to a temporary folder, distinct ports per test process, and every
 // process killed when the test ends, pass or fail.
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -154,12 +155,7 @@ class Fleet {
     return pred();
   }
 
-  std::string log(const std::string& id) const {
-    std::ifstream in(dir_ / (id + ".log"));
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
+  std::string log(const std::string& id) const { return readText(dir_ / (id + ".log")); }
 
  private:
   static size_t indexOf(const std::string& id, const std::vector<AgentSpec>& everyone) {
@@ -172,5 +168,17 @@ class Fleet {
   uint16_t base_port_;
   std::map<std::string, pid_t> pids_;
 };
+
+/// Stops every agent with SIGTERM and checks each leaves within 2 s, cleanly.
+inline void stopAll(Fleet& fleet, const std::vector<std::string>& ids) {
+  using namespace std::chrono_literals;
+  for (const auto& id : ids) fleet.kill(id, SIGTERM);
+  for (const auto& id : ids) {
+    const auto code = fleet.waitExit(id, 2000ms);
+    ASSERT_TRUE(code.has_value()) << id << " did not stop within 2 s\n" << fleet.log(id);
+    EXPECT_EQ(*code, 0) << fleet.log(id);
+    EXPECT_NE(fleet.log(id).find("stopped"), std::string::npos);
+  }
+}
 
 }  // namespace tomomap::test

@@ -20,17 +20,6 @@ Pose4 truth(const std::string& target_pose, const std::string& source_pose) {
   return Pose4::fromMatrix(loadPoseFile(target_pose) * loadPoseFile(source_pose).inverse());
 }
 
-/// Stops every agent with SIGTERM and checks each leaves within 2 s, cleanly.
-void stopAll(Fleet& fleet, const std::vector<std::string>& ids) {
-  for (const auto& id : ids) fleet.kill(id, SIGTERM);
-  for (const auto& id : ids) {
-    const auto code = fleet.waitExit(id, 2000ms);
-    ASSERT_TRUE(code.has_value()) << id << " did not stop within 2 s\n" << fleet.log(id);
-    EXPECT_EQ(*code, 0) << fleet.log(id);
-    EXPECT_NE(fleet.log(id).find("stopped"), std::string::npos);
-  }
-}
-
 /// Total matches computed across the fleet (from each agent's status).
 int computedAcrossFleet(const Fleet& fleet, const std::vector<std::string>& ids) {
   int n = 0;
@@ -165,8 +154,7 @@ TEST(Daemons, APeerMapOverTheMemoryBudgetIsRefusedAndTheDaemonStaysResponsive) {
       Fleet::waitFor([&] { return fleet.log("bravo").find("received the map of alpha") != std::string::npos; }, 120s))
       << fleet.log("bravo");
   const std::string log = fleet.log("alpha");
-  size_t lines = 0;
-  for (size_t at = log.find("rejected"); at != std::string::npos; at = log.find("rejected", at + 1)) ++lines;
+  const size_t lines = countOf(log, "rejected");
   EXPECT_LE(lines, 2u) << "one line, not one per sample\n" << log;
   EXPECT_EQ(log.find("received the map of bravo"), std::string::npos) << "alpha never holds bravo's map";
   stopAll(fleet, {"alpha", "bravo"});

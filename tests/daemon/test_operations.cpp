@@ -71,15 +71,8 @@ class NotifySocket {
   size_t seen_ = 0;
 };
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 void replaceIn(const std::string& path, const std::string& from, const std::string& to) {
-  std::string text = readFile(path);
+  std::string text = readText(path);
   const auto at = text.find(from);
   ASSERT_NE(at, std::string::npos) << from << " not in " << path;
   text.replace(at, from.size(), to);
@@ -178,7 +171,7 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
   const std::string staged = dir / "bravo.pcd.tmp";
   savePcd(staged, withCabinet(original));
   // First a writer that is cut off half-way, in place: the daemon must keep its map.
-  const std::string bytes = readFile(staged);
+  const std::string bytes = readText(staged);
   std::ofstream(bravo_map, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() / 2);
   ASSERT_TRUE(Fleet::waitFor([&] { return fleet.log("bravo").find("cannot be used") != std::string::npos; }, 30s))
       << fleet.log("bravo");

@@ -11,17 +11,11 @@
 #include "support.hpp"
 
 using namespace tomomap::fleet;
+using tomomap::test::readText;
 using tomomap::test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 
 FleetRequest request(const std::string& out, std::vector<std::string> agents) {
   FleetRequest r;
@@ -44,12 +38,12 @@ TEST(FleetKeys, EveryRobotsFilesVerifyAgainstTheFleetCa) {
     std::string why;
     EXPECT_TRUE(verify(cert, ca, "", why)) << why;
     EXPECT_EQ(subject(cert), "CN=" + agent + ",O=tomomap fleet");
-    const std::string grant = smimeVerify(slurp(d / RobotFiles::permissions), ca);
+    const std::string grant = smimeVerify(readText(d / RobotFiles::permissions), ca);
     EXPECT_NE(grant.find("<subject_name>CN=" + agent + ",O=tomomap fleet</subject_name>"), std::string::npos) << grant;
     EXPECT_NE(grant.find("<topic>tomomap/*</topic>"), std::string::npos);
-    EXPECT_NE(smimeVerify(slurp(d / RobotFiles::governance), ca).find("<enable_join_access_control>true"),
+    EXPECT_NE(smimeVerify(readText(d / RobotFiles::governance), ca).find("<enable_join_access_control>true"),
               std::string::npos);
-    EXPECT_EQ(slurp(d / RobotFiles::ca), slurp(fs::path(out) / "ca.pem")) << "each robot's folder is complete";
+    EXPECT_EQ(readText(d / RobotFiles::ca), readText(fs::path(out) / "ca.pem")) << "each robot's folder is complete";
     const auto perms = fs::status(d / RobotFiles::private_key).permissions();
     EXPECT_EQ(perms & (fs::perms::group_all | fs::perms::others_all), fs::perms::none) << "keys are private";
     readKey((d / RobotFiles::private_key).string());  // parses
@@ -61,7 +55,7 @@ TEST(FleetKeys, ATamperedDocumentOrAForeignCaDoesNotVerify) {
   makeFleet(request(dir / "ours", {"alpha"}));
   makeFleet(request(dir / "theirs", {"alpha"}));
   const Cert ours = readCert(dir / "ours/ca.pem"), theirs = readCert(dir / "theirs/ca.pem");
-  std::string permissions = slurp(dir / "ours/alpha/permissions.p7s");
+  std::string permissions = readText(dir / "ours/alpha/permissions.p7s");
   EXPECT_THROW(smimeVerify(permissions, theirs), std::runtime_error);
   const size_t at = permissions.find("<topic>tomomap/*</topic>");
   ASSERT_NE(at, std::string::npos);
@@ -76,18 +70,18 @@ TEST(FleetKeys, AddingRobotsKeepsTheCaAndReplacingNeedsToBeAskedFor) {
   TempDir dir;
   const std::string out = dir / "fleet";
   makeFleet(request(out, {"alpha"}));
-  const std::string ca = slurp(fs::path(out) / "ca.pem");
+  const std::string ca = readText(fs::path(out) / "ca.pem");
   const FleetResult more = makeFleet(request(out, {"bravo"}));
   EXPECT_FALSE(more.new_ca);
-  EXPECT_EQ(slurp(fs::path(out) / "ca.pem"), ca);
+  EXPECT_EQ(readText(fs::path(out) / "ca.pem"), ca);
   std::string why;
   EXPECT_TRUE(verify(readCert(out + "/bravo/cert.pem"), readCert(out + "/ca.pem"), "", why)) << why;
   EXPECT_THROW(makeFleet(request(out, {"alpha"})), std::runtime_error) << "alpha has keys already";
-  const std::string old_cert = slurp(fs::path(out) / "alpha/cert.pem");
+  const std::string old_cert = readText(fs::path(out) / "alpha/cert.pem");
   FleetRequest rotate = request(out, {"alpha"});
   rotate.replace = true;
   makeFleet(rotate);
-  EXPECT_NE(slurp(fs::path(out) / "alpha/cert.pem"), old_cert);
+  EXPECT_NE(readText(fs::path(out) / "alpha/cert.pem"), old_cert);
 }
 
 TEST(FleetKeys, ARevokedRobotsCertificateFailsAgainstTheListOthersPass) {
@@ -99,8 +93,8 @@ TEST(FleetKeys, ARevokedRobotsCertificateFailsAgainstTheListOthersPass) {
   revoke.revoke = {"bravo"};
   makeFleet(revoke);
   const Cert ca = readCert(out + "/ca.pem");
-  const std::string list = slurp(fs::path(out) / RobotFiles::crl);
-  EXPECT_EQ(slurp(fs::path(out) / "alpha" / RobotFiles::crl), list) << "every robot's folder gets the list";
+  const std::string list = readText(fs::path(out) / RobotFiles::crl);
+  EXPECT_EQ(readText(fs::path(out) / "alpha" / RobotFiles::crl), list) << "every robot's folder gets the list";
   std::string why;
   EXPECT_TRUE(verify(readCert(out + "/alpha/cert.pem"), ca, list, why)) << why;
   EXPECT_FALSE(verify(readCert(out + "/bravo/cert.pem"), ca, list, why));
