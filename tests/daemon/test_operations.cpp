@@ -5,8 +5,12 @@
 #include <sys/socket.h>
 #include <sys/un.h>
 
+#include <atomic>
+#include <condition_variable>
 #include <cstdio>
 #include <filesystem>
+#include <mutex>
+#include <thread>
 
 #include "fleet.hpp"
 #include "io/map_io.hpp"
@@ -17,7 +21,10 @@ using namespace std::chrono_literals;
 
 namespace {
 
-/// The receiving end of NOTIFY_SOCKET, as systemd binds it.
+/// The receiving end of NOTIFY_SOCKET, as systemd binds it. It reads all the
+/// time, as systemd does: a datagram socket holds only ~10 unread messages
+/// (net.unix.max_dgram_qlen), and a daemon whose watchdog pings go unread
+/// blocks in sd_notify.
 class NotifySocket {
  public:
   explicit NotifySocket(const std::string& path) : path_(path) {
@@ -26,38 +33,35 @@ class NotifySocket {
     a.sun_family = AF_UNIX;
     std::snprintf(a.sun_path, sizeof a.sun_path, "%s", path.c_str());
     if (bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) ADD_FAILURE() << "cannot bind " << path;
+    reader_ = std::thread([this] { read(); });
   }
-  ~NotifySocket() { close(fd_); }
+  ~NotifySocket() {
+    stop_ = true;
+    reader_.join();
+    close(fd_);
+  }
 
-  /// Collects datagrams until one contains `wanted` or `timeout` passes.
+  /// Waits until a message not yet waited for contains `wanted`.
   bool waitFor(const std::string& wanted, std::chrono::milliseconds timeout) {
-    const auto until = std::chrono::steady_clock::now() + timeout;
-    for (;;) {
+    std::unique_lock lock(mutex_);
+    return arrived_.wait_for(lock, timeout, [&] {
       for (size_t i = seen_; i < messages_.size(); ++i)
         if (messages_[i].find(wanted) != std::string::npos) {
           seen_ = i + 1;
           return true;
         }
-      seen_ = messages_.size();
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - std::chrono::steady_clock::now());
-      if (left.count() <= 0) return false;
-      pollfd p{fd_, POLLIN, 0};
-      if (poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
-      char buf[4096];
-      const ssize_t n = recv(fd_, buf, sizeof buf, 0);
-      if (n > 0) messages_.emplace_back(buf, static_cast<size_t>(n));
-    }
+      return false;
+    });
   }
-  /// Messages received so far (pending ones included) that contain `wanted`.
+  /// Messages received so far that contain `wanted`.
   size_t count(const std::string& wanted) {
-    char buf[4096];
-    for (ssize_t n; (n = recv(fd_, buf, sizeof buf, MSG_DONTWAIT)) > 0;)
-      messages_.emplace_back(buf, static_cast<size_t>(n));
+    std::lock_guard lock(mutex_);
     size_t n = 0;
     for (const auto& m : messages_) n += m.find(wanted) != std::string::npos;
     return n;
   }
-  std::string all() const {
+  std::string all() {
+    std::lock_guard lock(mutex_);
     std::string s;
     for (const auto& m : messages_) s += m + "\n";
     return s;
@@ -65,10 +69,27 @@ class NotifySocket {
   std::string env() const { return "NOTIFY_SOCKET=" + path_; }
 
  private:
+  void read() {
+    while (!stop_) {
+      pollfd p{fd_, POLLIN, 0};
+      if (poll(&p, 1, 50) <= 0) continue;
+      char buf[4096];
+      const ssize_t n = recv(fd_, buf, sizeof buf, 0);
+      if (n <= 0) continue;
+      std::lock_guard lock(mutex_);
+      messages_.emplace_back(buf, static_cast<size_t>(n));
+      arrived_.notify_all();
+    }
+  }
+
   std::string path_;
   int fd_ = -1;
+  std::mutex mutex_;
+  std::condition_variable arrived_;
   std::vector<std::string> messages_;
   size_t seen_ = 0;
+  std::atomic<bool> stop_{false};
+  std::thread reader_;
 };
 
 void replaceIn(const std::string& path, const std::string& from, const std::string& to) {
