@@ -22,6 +22,15 @@ void Agent::post(std::function<void()> work) {
   queue_cv_.notify_one();
 }
 
+namespace {
+
+std::string tiltText(const MapFeatures& f) {
+  if (!f.tilt.measured) return "tilt not measurable (too few flat surfaces)";
+  return (f.leveled ? "levelled: it leaned " : "tilt ") + fixed(degrees(f.tilt.angle), 1) + " deg";
+}
+
+}  // namespace
+
 OwnMap describeOwnMap(const Config& config) {
   const auto t0 = Clock::now();
   OwnMap own;
@@ -29,6 +38,8 @@ OwnMap describeOwnMap(const Config& config) {
     const Points map = loadMap(config.map, &own.nonfinite);  // dropped once described
     return std::make_shared<MapFeatures>(describeMap(map, config.match, nullptr, &own.cells));
   }();
+  // Peers would match slanted slices: offered nowhere, refused here.
+  if (const auto why = tiltRefusal(*features, "own", config.match)) throw InputError(config.map + ": " + *why);
   own.offer = transport::makeOffer(
       config.agent(), *features, config.match.features, binaryPcdBytes(own.cells),
       transport::maxSampleBytes(config.transport.bandwidth_kbps, config.transport.security.enabled()));
@@ -62,8 +73,8 @@ void Agent::installOwnMap(OwnMap own) {
       std::to_string(own_features_->featureCount()) + " features; version " + versionText(a.version()) +
       (update ? " (was " + versionText(before) + ")" : "") + "; payload " + std::to_string(offer.payload_bytes) +
       " bytes = " + fixed(100.0 * static_cast<double>(offer.payload_bytes) / static_cast<double>(a.raw_bytes()), 1) +
-      " % of the voxel-filtered map's binary PCD (" + std::to_string(a.raw_bytes()) + " bytes); described in " +
-      fixed(own.seconds, 2) + " s");
+      " % of the voxel-filtered map's binary PCD (" + std::to_string(a.raw_bytes()) + " bytes); " +
+      tiltText(*own_features_) + "; described in " + fixed(own.seconds, 2) + " s");
   if (bus_) {
     bus_->publish(a);
     persist(false);

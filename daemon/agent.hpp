@@ -115,6 +115,7 @@ class Agent {
   std::optional<Clock::time_point> map_touched_;  ///< last change seen and not yet described
   std::future<OwnMap> describing_;
   uint64_t map_updated_ms_ = 0;
+  std::string map_refused_;  ///< why the map file's latest content is not offered; empty when it is
   std::mutex queue_mutex_;
   std::condition_variable queue_cv_;
   std::deque<std::function<void()>> queue_;

@@ -50,12 +50,14 @@ void Agent::followMapFile() {
     if (describing_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
     try {
       OwnMap own = describing_.get();
+      map_refused_.clear();
       if (own.offer.announcement.version() == sender_.version())
         log_.info("map file rewritten with the same content: version " + versionText(sender_.version()) + " stays");
       else
         installOwnMap(std::move(own));
     } catch (const std::exception& e) {
       // Typically a file caught half-written: its next write brings us back.
+      map_refused_ = e.what();
       log_.warning(std::string("map file changed but cannot be used (") + e.what() + "); still offering version " +
                    versionText(sender_.version()));
     }

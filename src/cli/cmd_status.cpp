@@ -80,6 +80,12 @@ void printHuman(const json& status, const json& transforms, bool running) {
             << fixed(100.0 * map.value("payload_bytes", 0.0) / std::max(1.0, map.value("raw_bytes", 1.0)), 1)
             << " % of the map's binary PCD)" << (map.value("updating", false) ? ", an update is being described" : "")
             << "\n";
+  if (map.contains("tilt_deg") && map["tilt_deg"].is_number())
+    std::cout << "           " << (map.value("leveled", false) ? "levelled, it leaned " : "tilt ")
+              << fixed(map["tilt_deg"].get<double>(), 1) << " deg\n";
+  if (!map.value("update_refused", std::string()).empty())
+    std::cout << "           the map file's new content is NOT offered: " << map["update_refused"].get<std::string>()
+              << "\n";
   std::cout << "  sent     " << kB(status["sent"].value("bytes", 0.0)) << " in " << status["sent"].value("samples", 0)
             << " samples, budget " << status.value("bandwidth_kbps", 0.0) << " kbit/s\n";
   std::cout << "  peers\n";

@@ -13,7 +13,7 @@ struct SynthOptions {
   std::string world = "indoor", noise = "low", out;
   uint64_t seed = 1;
   int maps = 2;
-  double scale = 1.0;
+  double scale = 1.0, tilt_deg = 0.0;
   std::optional<double> pose_sigma, yaw_sigma, range_sigma;
   bool progress = false;
 };
@@ -24,6 +24,7 @@ int runSynth(const SynthOptions& o) {
   sp.seed = o.seed;
   sp.maps = o.maps;
   sp.scale = o.scale;
+  sp.tilt = radians(o.tilt_deg);
   synth::NoiseModel noise = synth::noiseLevel(o.noise);
   if (o.pose_sigma) noise.pose_translation = *o.pose_sigma;
   if (o.yaw_sigma) noise.pose_yaw = *o.yaw_sigma;
@@ -64,6 +65,9 @@ Command addSynthCommand(CLI::App& app) {
   sub->add_option("--scale", o->scale, "stretch the world's length (0.5 to 20)")
       ->capture_default_str()
       ->check(CLI::Range(0.5, 20.0));
+  sub->add_option("--tilt", o->tilt_deg, "roll every map but the first this much about x [deg]: a leaning map frame")
+      ->capture_default_str()
+      ->check(CLI::Range(-90.0, 90.0));
   sub->add_flag("--progress", o->progress, "show progress even when stderr is not a terminal");
   return {sub, [o] { return runSynth(*o); }};
 }

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "core/map_bounds.hpp"
+#include "core/text.hpp"
 #include "io/map_io.hpp"
 #include "progress.hpp"
 
@@ -11,6 +12,8 @@ namespace tomomap::cli {
 
 MatchedFiles matchFiles(const MatchFilesOptions& o) {
   if (!(o.params.grid > 0.0)) throw InputError("grid size must be positive");
+  MatchParams params = o.params;
+  params.max_tilt = radians(o.max_tilt_deg);
   requireBothOrNeither(o.gt_target, o.gt_source);
   MatchedFiles m;
   if (!o.gt_target.empty()) m.P_target = loadPoseFile(o.gt_target);
@@ -24,7 +27,10 @@ MatchedFiles matchFiles(const MatchFilesOptions& o) {
     if (nonfinite > 0)
       std::cerr << "warning: " << path << ": dropped " << nonfinite << " points with NaN or infinite coordinates\n";
     if (!o.quiet) std::cout << role << " " << path << " (" << map.size() << " points)\n";
-    MapFeatures f = describeMap(map, o.params, &timings);
+    MapFeatures f = describeMap(map, params, &timings);
+    if (f.leveled)
+      std::cerr << "note: " << path << ": levelled: it leaned " << fixed(degrees(f.tilt.angle), 1)
+                << " deg from gravity\n";
     m.sizes[std::string(role) + "_stray_voxels"] = f.occupancy.stray;
     if (f.occupancy.stray > 0)
       std::cerr << "warning: " << path << ": left out " << f.occupancy.stray
@@ -34,7 +40,7 @@ MatchedFiles matchFiles(const MatchFilesOptions& o) {
   m.target = describe(o.target, "target");
   m.source = describe(o.source, "source");
   if (!o.quiet) std::cout << "grid " << o.params.grid << " m\n";
-  m.result = matchFeatures(m.target, m.source, o.params, terminalProgress(o.progress || stderrIsTerminal()));
+  m.result = matchFeatures(m.target, m.source, params, terminalProgress(o.progress || stderrIsTerminal()));
   m.result.timings.takeDescription(timings);
   return m;
 }
@@ -51,6 +57,10 @@ void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
   sub.add_option("-j,--threads", o.params.threads, "worker threads (0 = all cores)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));
+  sub.add_option("--max-tilt", o.max_tilt_deg, "refuse a map tilted more than this from gravity [deg]")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 90.0));
+  sub.add_flag("--level", o.params.level, "level a tilted map (turn its up onto z) instead of refusing it");
   sub.add_flag("--progress", o.progress, "show progress even when stderr is not a terminal");
   sub.add_flag("-q,--quiet", o.quiet, "print only the result");
 }

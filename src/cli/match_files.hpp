@@ -12,6 +12,7 @@ namespace tomomap::cli {
 struct MatchFilesOptions {
   std::string target, source, gt_target, gt_source;
   MatchParams params;
+  double max_tilt_deg = degrees(MatchParams{}.max_tilt);
   bool progress = false, quiet = false;
 };
 

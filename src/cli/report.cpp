@@ -16,20 +16,34 @@ std::string format(const char* fmt, Args... args) {
   return buf;
 }
 
-nlohmann::json poseJson(const Pose4& p) {
+nlohmann::json matrixJson(const Eigen::Matrix4d& M) {
   nlohmann::json m = nlohmann::json::array();
-  const Eigen::Matrix4d M = p.matrix();
   for (int r = 0; r < 4; ++r) m.push_back({M(r, 0), M(r, 1), M(r, 2), M(r, 3)});
-  return {{"x", p.x}, {"y", p.y}, {"z", p.z}, {"yaw", p.yaw}, {"matrix", m}};
+  return m;
 }
+
+nlohmann::json poseJson(const Pose4& p) {
+  return {{"x", p.x}, {"y", p.y}, {"z", p.z}, {"yaw", p.yaw}, {"matrix", matrixJson(p.matrix())}};
+}
+
+std::string tiltText(double tilt) { return tilt < 0 ? "not measurable" : format("%.1f deg", degrees(tilt)); }
+
+nlohmann::json tiltJson(double tilt) { return tilt < 0 ? nlohmann::json() : nlohmann::json(degrees(tilt)); }
 
 }  // namespace
 
 GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const Eigen::Matrix4d& P_target,
                                          const Eigen::Matrix4d& P_source, double grid) {
   GroundTruthCheck c;
-  c.expected = Pose4::fromMatrix(P_target * P_source.inverse());
-  c.error = poseError(r.T_target_source, c.expected);
+  const Eigen::Matrix4d expected = P_target * P_source.inverse();
+  c.expected = Pose4::fromMatrix(expected);
+  // Whole matrices: with a levelled map the answer is no longer 4-DoF, and the
+  // rotation error is then the full angle between the two rotations.
+  const Eigen::Matrix4d estimate = r.matrix();
+  c.error.translation = (estimate.topRightCorner<3, 1>() - expected.topRightCorner<3, 1>()).norm();
+  c.error.yaw =
+      Eigen::AngleAxisd(Eigen::Matrix3d(estimate.topLeftCorner<3, 3>().transpose() * expected.topLeftCorner<3, 3>()))
+          .angle();
   c.translation_limit = 5.0 * grid;
   c.yaw_limit = radians(10.0);
   return c;
@@ -40,7 +54,8 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
   if (r.reliable) {
     out << format("T_target_source  x %.4f  y %.4f  z %.4f m  yaw %.4f rad (%.2f deg)\n", T.x, T.y, T.z, T.yaw,
                   degrees(T.yaw));
-    const Eigen::Matrix4d M = T.matrix();
+    if (r.T_target_source_unleveled) out << "  between the levelled maps; in the maps' own frames:\n";
+    const Eigen::Matrix4d M = r.matrix();
     for (int i = 0; i < 4; ++i) out << format("  [%9.5f %9.5f %9.5f %9.4f]\n", M(i, 0), M(i, 1), M(i, 2), M(i, 3));
   } else {
     out << "no reliable match: " << r.reason << "\n";
@@ -54,6 +69,7 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
     out << format(
         "quality          support %d slice pairs (runner-up %d), %zu inliers, spread x %.2f y %.2f z %.2f m\n",
         r.support, r.runner_up_support, r.inliers, r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z());
+    out << "tilt             target " << tiltText(r.target_tilt) << ", source " << tiltText(r.source_tilt) << "\n";
     out << format("slices           target %d (%zu features), source %d (%zu features), %zu slice pairs\n",
                   r.target_slices, r.target_features, r.source_slices, r.source_features, r.slice_pairs);
     const auto& t = r.timings;
@@ -75,10 +91,13 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
 nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck>& gt) {
   nlohmann::json j;
   j["reliable"] = r.reliable;
-  if (r.reliable)
+  if (r.reliable) {
     j["T_target_source"] = poseJson(r.T_target_source);
-  else
+    if (r.T_target_source_unleveled) j["T_target_source_unleveled"] = matrixJson(*r.T_target_source_unleveled);
+  } else {
     j["reason"] = r.reason;
+  }
+  j["tilt_deg"] = {{"target", tiltJson(r.target_tilt)}, {"source", tiltJson(r.source_tilt)}};
   j["quality"] = {{"support", r.support},
                   {"height_offset_slices", r.height_offset},
                   {"runner_up_support", r.runner_up_support},

@@ -14,7 +14,8 @@ GeneratedWorld writeSynthWorld(const synth::SceneParams& params, const synth::No
   std::filesystem::create_directories(dir, ec);
   if (ec) throw InputError(dir + ": cannot create output directory: " + ec.message());
   const synth::Scene scene = synth::makeScene(params);
-  const auto maps = synth::scanScene(scene, noise, params.seed, progress);
+  auto maps = synth::scanScene(scene, noise, params.seed, progress);
+  for (size_t i = 1; i < maps.size() && params.tilt != 0.0; ++i) synth::roll(maps[i], params.tilt);
 
   GeneratedWorld out;
   out.grid = scene.grid;
@@ -22,6 +23,7 @@ GeneratedWorld writeSynthWorld(const synth::SceneParams& params, const synth::No
       {"world", synth::toString(params.type)},
       {"seed", params.seed},
       {"grid", scene.grid},
+      {"tilt_deg", degrees(params.tilt)},
       {"noise", {{"pose_translation", noise.pose_translation}, {"pose_yaw", noise.pose_yaw}, {"range", noise.range}}},
       {"maps", nlohmann::json::array()}};
   for (size_t i = 0; i < maps.size(); ++i) {

@@ -2,6 +2,7 @@
 // ORB features per slice: the compact description of a map that crosses the network.
 #include <opencv2/core.hpp>
 
+#include "gravity.hpp"
 #include "slices.hpp"
 
 namespace tomomap {
@@ -27,6 +28,10 @@ struct MapFeatures {
   /// The slices' occupied cells, when available (always offline; over the network
   /// when the sender ships them). Lets the matcher refine densely; may be empty.
   SliceStack occupancy;
+  /// How the map was found to lean before slicing, and whether it was levelled
+  /// (turned by tilt.leveling()) first. Known where the map was described, not sent.
+  Tilt tilt;
+  bool leveled = false;
 
   double sliceHeight(int k) const { return z_min + k * grid; }
   size_t featureCount() const;

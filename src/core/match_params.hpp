@@ -19,6 +19,10 @@ struct MatchParams {
   int min_support = 3;                       ///< agreeing slice pairs needed for a reliable match
   int min_inliers = 20;                      ///< inlier correspondences needed for a reliable match
   int threads = 0;                           ///< threads one match uses; 0 = every core
+  /// A map whose z axis is farther than this from gravity is refused: its
+  /// slices cut walls at a slant (see docs/results.md for where 2 degrees comes from).
+  double max_tilt = radians(2.0);  ///< [rad]
+  bool level = false;              ///< level a tilted map (turn its up onto z) instead of refusing it
 };
 
 /// Called with (stage name, done, total) as work advances; may be empty.

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 
 #include "height_offsets.hpp"
 #include "map_check.hpp"
 #include "refine.hpp"
+#include "text.hpp"
 #include "voxel_filter.hpp"
 
 namespace tomomap {
@@ -41,6 +43,16 @@ bool ambiguous(const MatchResult& r) {
          static_cast<double>(r.support) < kClearAhead * static_cast<double>(r.runner_up_support);
 }
 
+/// p_target = R_target^-1 T R_source p_source, with R a map's levelling rotation.
+Eigen::Matrix4d unleveled(const Pose4& T, const MapFeatures& target, const MapFeatures& source) {
+  const auto rotation = [](const MapFeatures& m) {
+    Eigen::Matrix4d R = Eigen::Matrix4d::Identity();
+    if (m.leveled) R.topLeftCorner<3, 3>() = m.tilt.leveling().toRotationMatrix();
+    return R;
+  };
+  return rotation(target).inverse() * T.matrix() * rotation(source);
+}
+
 /// "No reliable match" and why, or reliable.
 void judge(MatchResult& r, const MatchParams& params) {
   if (r.support < params.min_support)
@@ -59,19 +71,38 @@ void judge(MatchResult& r, const MatchParams& params) {
 
 }  // namespace
 
+std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string& role, const MatchParams& params) {
+  if (map.leveled || !map.tilt.measured || map.tilt.angle <= params.max_tilt) return std::nullopt;
+  if (params.level)
+    return role + " map is tilted " + fixed(degrees(map.tilt.angle), 1) +
+           " deg from gravity, too far to level (limit " + fixed(degrees(kMaxLevelable), 0) +
+           " deg): its axes may be swapped (y up); fix its frame";
+  return role + " map is tilted " + fixed(degrees(map.tilt.angle), 1) + " deg from gravity (limit " +
+         fixed(degrees(params.max_tilt), 1) +
+         " deg): its slices would cut walls at a slant; level it first (tomomap match --level, or level = true in the "
+         "daemon's [match] table)";
+}
+
 MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings, size_t* filtered_points) {
   StageTimings local;
   StageTimings& t = timings ? *timings : local;
   auto t0 = Clock::now();
-  const Points filtered = voxelFilter(map, params.grid);
+  Points filtered = voxelFilter(map, params.grid);
   t.voxel += secondsSince(t0);
-  if (filtered_points) *filtered_points = filtered.size();
   t0 = Clock::now();
+  // From the raw points: the filter's grid would bias a leaning plane's normals towards the axes.
+  const Tilt tilt = estimateTilt(map, params.grid);
+  const bool level = params.level && tilt.measured && tilt.angle <= kMaxLevelable;
+  // The levelled map is filtered again: rotated voxels no longer sit on the grid.
+  if (level) filtered = voxelFilter(rotatePoints(filtered, tilt.leveling()), params.grid);
+  if (filtered_points) *filtered_points = filtered.size();
   SliceStack stack = makeSlices(filtered, params.grid);
   t.slicing += secondsSince(t0);
   t0 = Clock::now();
   MapFeatures f = extractFeatures(std::move(stack), params.features);
   t.features += secondsSince(t0);
+  f.tilt = tilt;
+  f.leveled = level;
   return f;
 }
 
@@ -82,6 +113,13 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   r.source_slices = source.slice_count;
   r.target_features = target.featureCount();
   r.source_features = source.featureCount();
+  r.target_tilt = target.tilt.measured ? target.tilt.angle : -1.0;
+  r.source_tilt = source.tilt.measured ? source.tilt.angle : -1.0;
+  if (auto why = tiltRefusal(target, "target", params).value_or(tiltRefusal(source, "source", params).value_or(""));
+      !why.empty()) {
+    r.reason = std::move(why);
+    return r;
+  }
   if (std::abs(target.grid - source.grid) > 1e-9)
     throw InputError("feature sets use different grid sizes (" + std::to_string(target.grid) + " and " +
                      std::to_string(source.grid) + " m)");
@@ -121,6 +159,7 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
 
   r.T_target_source = {refined.T.t.x(), refined.T.t.y(), target.z_min - source.z_min + best.offset * target.grid,
                        wrapAngle(refined.T.yaw)};
+  if (target.leveled || source.leveled) r.T_target_source_unleveled = unleveled(r.T_target_source, target, source);
   r.inliers = refined.inliers.size();
   r.inlier_spread = inlierSpread(refined);
   judge(r, params);

@@ -1,5 +1,6 @@
 #pragma once
 // Height cross-correlation of two tomographic feature stacks (ALGORITHM.md sections 4-7).
+#include <optional>
 #include <string>
 
 #include "match_params.hpp"
@@ -31,7 +32,14 @@ struct MatchResult {
   /// must not be used; `reason` says why.
   bool reliable = false;
   std::string reason;
-  Pose4 T_target_source;  ///< p_target = T_target_source * p_source
+  Pose4 T_target_source;  ///< p_target = T_target_source * p_source (between the levelled frames, if levelled)
+  /// When a map was levelled: the transform between the maps' own frames,
+  /// leveling included (no longer 4-DoF). Empty otherwise.
+  std::optional<Eigen::Matrix4d> T_target_source_unleveled;
+  double target_tilt = 0, source_tilt = 0;  ///< as measured before any levelling [rad]; -1 = not measurable
+
+  /// The transform to apply to source points to bring them into the target's frame.
+  Eigen::Matrix4d matrix() const { return T_target_source_unleveled.value_or(T_target_source.matrix()); }
 
   int support = 0;                                          ///< agreeing slice pairs at the winning height offset
   int runner_up_support = 0;                                ///< best support more than one step away from the winner
@@ -52,6 +60,10 @@ struct MatchResult {
 /// (height_offsets.hpp), the winner refined (refine.hpp), the answer judged.
 MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
                           const Progress& progress = {});
+
+/// Why a described map is too tilted to match (see MatchParams::max_tilt and
+/// level), naming it by `role`; empty if it is fine.
+std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string& role, const MatchParams& params);
 
 /// Voxel filter, slicing, features and matching for two raw maps.
 MatchResult matchMaps(const Points& target, const Points& source, const MatchParams& params,

@@ -36,6 +36,7 @@ struct SceneParams {
   uint64_t seed = 1;
   int maps = 2;        ///< trajectories (maps) through the world, overlapping in sequence
   double scale = 1.0;  ///< stretches the world's length (outdoor street, indoor corridor)
+  double tilt = 0.0;   ///< every map but the first is rolled this much about its x axis (see roll) [rad]
 };
 
 /// Indoor: a two-floor building, corridor with rooms on both sides, doors,

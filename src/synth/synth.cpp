@@ -3,6 +3,7 @@
 #include <atomic>
 #include <random>
 
+#include "core/gravity.hpp"
 #include "core/voxel_filter.hpp"
 
 namespace tomomap::synth {
@@ -83,6 +84,14 @@ std::vector<SynthMap> scanScene(const Scene& scene, const NoiseModel& noise, uin
     maps.push_back(std::move(map));
   }
   return maps;
+}
+
+void roll(SynthMap& map, double angle) {
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()));
+  map.points = rotatePoints(map.points, q);
+  Eigen::Matrix4d R = Eigen::Matrix4d::Identity();
+  R.topLeftCorner<3, 3>() = q.toRotationMatrix();
+  map.pose = R * map.pose;
 }
 
 }  // namespace tomomap::synth

@@ -29,4 +29,8 @@ struct SynthMap {
 std::vector<SynthMap> scanScene(const Scene& scene, const NoiseModel& noise, uint64_t seed,
                                 const std::function<void(size_t, size_t)>& progress = {});
 
+/// Rolls a map's frame by `angle` about its x axis, points and ground truth
+/// together: a map from LiDAR odometry whose first sensor frame leaned.
+void roll(SynthMap& map, double angle);
+
 }  // namespace tomomap::synth

@@ -1,0 +1,98 @@
+// How far a map leans from gravity, and what the matcher does about it.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/gravity.hpp"
+#include "core/matcher.hpp"
+#include "support.hpp"
+
+using namespace tomomap;
+
+namespace {
+
+/// A furnished 6 x 5 x 2.8 m room: floor, ceiling, four walls and a table top,
+/// points every 3 cm with 1 cm of noise.
+Points room() {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.0f, 0.01f);
+  Points p;
+  const auto plane = [&](const Eigen::Vector3f& o, const Eigen::Vector3f& u, const Eigen::Vector3f& v) {
+    const float step = 0.03f;
+    for (float a = 0; a <= u.norm(); a += step)
+      for (float b = 0; b <= v.norm(); b += step)
+        p.push_back(o + a * u.normalized() + b * v.normalized() + Eigen::Vector3f(noise(rng), noise(rng), noise(rng)));
+  };
+  const Eigen::Vector3f X(6, 0, 0), Y(0, 5, 0), Z(0, 0, 2.8f);
+  plane({0, 0, 0}, X, Y);
+  plane({0, 0, 2.8f}, X, Y);
+  plane({0, 0, 0}, X, Z);
+  plane({0, 5, 0}, X, Z);
+  plane({0, 0, 0}, Y, Z);
+  plane({6, 0, 0}, Y, Z);
+  plane({2, 2, 0.75f}, {1.2f, 0, 0}, {0, 0.8f, 0});
+  return p;
+}
+
+Eigen::Quaterniond lean(double deg, const Eigen::Vector3d& axis) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(radians(deg), axis.normalized()));
+}
+
+}  // namespace
+
+TEST(Gravity, ALevelRoomReadsLevel) {
+  const Tilt t = estimateTilt(room(), 0.05);
+  ASSERT_TRUE(t.measured);
+  EXPECT_LT(degrees(t.angle), 0.2);
+  EXPECT_GT(t.floor_patches, 20u);
+  EXPECT_GT(t.wall_patches, 20u);
+}
+
+TEST(Gravity, ALeaningRoomReadsItsLeanAndLevellingUndoesIt) {
+  for (const double deg : {1.0, 3.0, 10.0, 25.0}) {
+    const Eigen::Quaterniond q = lean(deg, {1, 0.4, 0});
+    const Points leaning = rotatePoints(room(), q);
+    const Tilt t = estimateTilt(leaning, 0.05);
+    ASSERT_TRUE(t.measured) << deg;
+    EXPECT_NEAR(degrees(t.angle), deg, 0.2) << deg;
+    // Levelled, the map's floor faces z again.
+    EXPECT_LT(degrees(estimateTilt(rotatePoints(leaning, t.leveling()), 0.05).angle), 0.2) << deg;
+    // The levelling rotation adds no yaw: it is the lean undone.
+    EXPECT_LT(degrees((t.leveling() * q).angularDistance(Eigen::Quaterniond::Identity())), 0.3) << deg;
+  }
+}
+
+TEST(Gravity, AFewScatteredPointsAreNotMeasured) {
+  Points p;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(0.0f, 20.0f);
+  for (int i = 0; i < 2000; ++i) p.emplace_back(u(rng), u(rng), u(rng));
+  EXPECT_FALSE(estimateTilt(p, 0.05).measured);
+}
+
+TEST(Matcher, ATiltedMapIsRefusedAndCanBeLevelled) {
+  REQUIRE_DEMO_ROOM();
+  const auto demo = test::loadDemoPair();
+  const Eigen::Quaterniond q = lean(5.0, {1, 0, 0});
+  const Points rolled = rotatePoints(demo.map2, q);
+
+  const MatchResult refused = matchMaps(demo.map1, rolled, MatchParams{});
+  EXPECT_FALSE(refused.reliable);
+  EXPECT_NE(refused.reason.find("source map is tilted"), std::string::npos) << refused.reason;
+  EXPECT_NEAR(degrees(refused.source_tilt), 5.0, 1.0);
+
+  MatchParams level;
+  level.level = true;
+  const MatchResult r = matchMaps(demo.map1, rolled, level);
+  ASSERT_TRUE(r.reliable) << r.reason;
+  ASSERT_TRUE(r.T_target_source_unleveled.has_value());
+  // p1 = T_1_2 p2 and p2 = q^-1 p_rolled: the answer must be T_1_2 q^-1.
+  Eigen::Matrix4d unroll = Eigen::Matrix4d::Identity();
+  unroll.topLeftCorner<3, 3>() = q.inverse().toRotationMatrix();
+  const Eigen::Matrix4d expected = demo.T_1_2.matrix() * unroll, got = r.matrix();
+  EXPECT_LT((got.topRightCorner<3, 1>() - expected.topRightCorner<3, 1>()).norm(), 0.1);
+  EXPECT_LT(
+      degrees(Eigen::AngleAxisd(Eigen::Matrix3d(got.topLeftCorner<3, 3>().transpose() * expected.topLeftCorner<3, 3>()))
+                  .angle()),
+      1.0);
+}
