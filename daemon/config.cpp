@@ -47,7 +47,6 @@ const std::vector<std::string> kKeys{"agent",
                                      "match.min_inliers",
                                      "match.threads",
                                      "match.max_tilt_deg",
-                                     "match.level",
                                      "security.ca",
                                      "security.certificate",
                                      "security.private_key",
@@ -84,13 +83,6 @@ struct Reader {
     }
     if (!n->is_string()) fail(*n, key, "must be a string");
     return n->value<std::string>().value();
-  }
-
-  bool boolean(const toml::table& t, const std::string& key, bool fallback) const {
-    const toml::node* n = t.get(key);
-    if (!n) return fallback;
-    if (!n->is_boolean()) fail(*n, key, "must be true or false");
-    return n->value<bool>().value();
   }
 
   double number(const toml::table& t, const std::string& key, std::optional<double> fallback, double lo,
@@ -148,7 +140,6 @@ void readMatch(const Reader& r, const toml::table& root, MatchParams& m) {
   m.min_inliers = r.integer(*t, "min_inliers", m.min_inliers, 2, 100000);
   m.threads = r.integer(*t, "threads", m.threads, 0, 256);
   m.max_tilt = radians(r.number(*t, "max_tilt_deg", degrees(m.max_tilt), 0, 90));
-  m.level = r.boolean(*t, "level", m.level);
 }
 
 /// The [security] table: DDS Security's files, each of which must exist
@@ -290,7 +281,7 @@ std::string describe(const Config& c) {
     << "\n  match.consensus_translation_cells = " << m.consensus_translation_cells
     << "\n  match.consensus_yaw_deg = " << degrees(m.consensus_yaw) << "\n  match.min_support = " << m.min_support
     << "\n  match.min_inliers = " << m.min_inliers << "\n  match.threads = " << m.threads
-    << "\n  match.max_tilt_deg = " << degrees(m.max_tilt) << "\n  match.level = " << (m.level ? "true" : "false");
+    << "\n  match.max_tilt_deg = " << degrees(m.max_tilt);
   const auto& f = t.security;
   if (f.enabled())
     o << "\n  security.ca = " << f.ca << "\n  security.certificate = " << f.certificate

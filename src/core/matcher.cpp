@@ -79,8 +79,7 @@ std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string
            " deg): its axes may be swapped (y up); fix its frame";
   return role + " map is tilted " + fixed(degrees(map.tilt.angle), 1) + " deg from gravity (limit " +
          fixed(degrees(params.max_tilt), 1) +
-         " deg): its slices would cut walls at a slant; level it first (tomomap match --level, or level = true in the "
-         "daemon's [match] table)";
+         " deg): its slices would cut walls at a slant; level it first (tomomap match --level)";
 }
 
 MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings, size_t* filtered_points) {

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <thread>
 
+#include "core/gravity.hpp"
 #include "fleet.hpp"
 #include "io/map_io.hpp"
 
@@ -247,4 +248,50 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
 
   for (const char* id : {"alpha", "bravo"}) fleet.kill(id, SIGTERM);
   for (const char* id : {"alpha", "bravo"}) EXPECT_EQ(fleet.waitExit(id, 2000ms), 0);
+}
+
+TEST(Operations, ATiltedMapIsNeitherOfferedNorAllowedToReplaceTheAgreedTransform) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  const std::string d = demoRoom() + "/";
+  const Points original = loadMap(d + "demo-pcd2.pcd");
+  const std::string bravo_map = dir / "bravo.pcd";
+  savePcd(bravo_map, original);
+  Fleet fleet(dir);
+  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd"}, {"bravo", bravo_map}};
+  for (const auto& a : agents) fleet.start(a, agents);
+  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 60s)) << fleet.log("alpha") << fleet.log("bravo");
+  EXPECT_NE(fleet.log("bravo").find("; tilt 0."), std::string::npos) << "the own map's tilt is logged\n"
+                                                                     << fleet.log("bravo");
+  const auto status = fleet.readJson("bravo", "status.json");
+  const std::string v1 = status["map"]["version"];
+  EXPECT_LT(status["map"]["tilt_deg"].get<double>(), 1.0);
+  const auto agreed = fleet.transforms("alpha").at("alpha<-bravo");
+
+  // The SLAM system restarts with its first IMU frame leaning 5 degrees.
+  const Points rolled =
+      rotatePoints(original, Eigen::Quaterniond(Eigen::AngleAxisd(radians(5), Eigen::Vector3d::UnitX())));
+  savePcd(dir / "bravo.pcd.tmp", rolled);
+  std::filesystem::rename(dir / "bravo.pcd.tmp", bravo_map);
+  ASSERT_TRUE(Fleet::waitFor(
+      [&] { return !fleet.readJson("bravo", "status.json")["map"].value("update_refused", "").empty(); }, 60s))
+      << fleet.log("bravo");
+  EXPECT_NE(fleet.log("bravo").find("own map is tilted "), std::string::npos) << fleet.log("bravo");
+  EXPECT_EQ(fleet.readJson("bravo", "status.json")["map"]["version"], v1) << "the level map stays on offer";
+  const auto view = runTomomap("status " + (dir / "out-bravo"));
+  EXPECT_NE(view.output.find("NOT offered: "), std::string::npos) << view.output;
+  for (const char* id : {"alpha", "bravo"}) {
+    const auto t = fleet.transforms(id);
+    ASSERT_TRUE(t.count("alpha<-bravo"));
+    EXPECT_EQ(t.at("alpha<-bravo")["T_target_source"], agreed["T_target_source"]) << id;
+    EXPECT_TRUE(t.at("alpha<-bravo")["reliable"].get<bool>()) << id;
+  }
+  for (const char* id : {"alpha", "bravo"}) fleet.kill(id, SIGTERM);
+  for (const char* id : {"alpha", "bravo"}) EXPECT_EQ(fleet.waitExit(id, 2000ms), 0);
+
+  // Started on the leaning map, the daemon refuses it and says why: exit 2, which systemd does not restart.
+  fleet.start(agents[1], agents);
+  EXPECT_EQ(fleet.waitExit("bravo", 60s), 2);
+  EXPECT_EQ(countOf(fleet.log("bravo"), "own map is tilted"), 2u) << "once refused as an update, once at start\n"
+                                                                  << fleet.log("bravo");
 }
