@@ -22,7 +22,7 @@ struct MatchParams {
   /// A map whose z axis is farther than this from gravity is refused: its
   /// slices cut walls at a slant (see docs/results.md for where 2 degrees comes from).
   double max_tilt = radians(2.0);  ///< [rad]
-  bool level = false;              ///< level a tilted map (turn its up onto z) instead of refusing it
+  bool level = false;              ///< level a map tilted beyond max_tilt (turn its up onto z) instead of refusing it
 };
 
 /// Called with (stage name, done, total) as work advances; may be empty.
