@@ -179,9 +179,18 @@ void Agent::onEstimate(wire::TransformEstimate&& e) {
                            " y " + fixed(t.T_target_source.y, 3) + " z " + fixed(t.T_target_source.z, 3) + " yaw " +
                            fixed(t.T_target_source.yaw, 4) +
                            (t.reliable ? "" : " (no reliable match: " + t.reason + ")");
+  const PairKey pair = t.pair();
   if (board_.estimateSeen(std::move(t)) != PairBoard::Offer::Stored) return;
   log_.info(line);
+  logIfKept(pair);
   persist(true);
+}
+
+void Agent::logIfKept(const PairKey& pair) {
+  const PairStatus s = board_.status(pair, Clock::now());
+  if (s.state == PairState::Kept)
+    log_.warning(pairText(pair) + ": the current maps gave no reliable match (" + s.why +
+                 "); the reliable transform agreed for their earlier versions stays");
 }
 
 void Agent::onPeer(const std::string& id, bool alive) {
@@ -197,8 +206,9 @@ void Agent::onPeer(const std::string& id, bool alive) {
     // late reader now and then (eProsima/Fast-DDS#3822): announce again soon.
     reannounce_ = true;
     // A late joiner gets what this agent computed, in case durability missed it.
-    for (const auto& [key, t] : board_.results())
-      if (t.computed_by == config_.agent()) bus_->publish(transport::toWire(t));
+    for (const auto* held : {&board_.results(), &board_.keptBeside()})
+      for (const auto& [key, t] : *held)
+        if (t.computed_by == config_.agent()) bus_->publish(transport::toWire(t));
   } else if (peers_.setAlive(id, false)) {
     log_.warning("peer " + id + " is gone");
     board_.agentGone(id);
@@ -245,7 +255,9 @@ void Agent::finishCompute() {
                        ", support " + std::to_string(t.support) + ", " + std::to_string(t.inliers) + " inliers"
                  : "no reliable match: " + t.reason));
   bus_->publish(transport::toWire(t));
+  const PairKey pair = t.pair();
   board_.computed(std::move(t));
+  logIfKept(pair);
   persist(true);
 }
 

@@ -99,6 +99,8 @@ class Agent {
   void requestMissing(bool at_once = false);
   void claimAndCompute();
   void finishCompute();
+  /// Says so when a stored answer did not replace the pair's reliable one.
+  void logIfKept(const PairKey& pair);
   std::shared_ptr<const MapFeatures> featuresOf(const std::string& agent) const;
 
   // ---- what it tells its operator (agent_status.cpp)

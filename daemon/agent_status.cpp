@@ -27,6 +27,7 @@ void Agent::persist(bool transforms_changed) {
       const PairStatus s = board_.status(key, now);
       nlohmann::json p{{"pair", pairText(key)}, {"state", stateName(s.state)}};
       if (!s.by.empty()) p["by"] = s.by;
+      if (!s.why.empty()) p["why"] = s.why;
       pairs.push_back(p);
     }
     const auto& offer = sender_.offer();

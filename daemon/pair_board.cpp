@@ -20,6 +20,8 @@ const char* stateName(PairState s) {
       return "agreed";
     case PairState::Stale:
       return "stale";
+    case PairState::Kept:
+      return "kept";
   }
   return "?";
 }
@@ -88,11 +90,11 @@ PairBoard::Offer PairBoard::estimateSeen(AgreedTransform t) {
     pending_[{key, t.computed_by}] = std::move(t);
     return Offer::Pending;
   }
-  const auto it = results_.find(key);
-  if (it != results_.end() && it->second.isFor(t.target_version, t.source_version) &&
-      !outranks(t.computed_by, it->second.computed_by))
-    return Offer::Duplicate;  // the same result again, or a duplicate computation: keep one, deterministically
-  results_[key] = std::move(t);
+  for (const auto* held : {&results_, &unreliable_})
+    if (const auto it = held->find(key); it != held->end() && it->second.isFor(t.target_version, t.source_version) &&
+                                         !outranks(t.computed_by, it->second.computed_by))
+      return Offer::Duplicate;  // the same result again, or a duplicate computation: keep one, deterministically
+  store(std::move(t));
   claims_.erase(key);
   own_claims_.erase(key);
   return Offer::Stored;
@@ -124,8 +126,7 @@ BoardStep PairBoard::step(Clock::time_point now) {
     for (size_t j = i + 1; j < holders.size(); ++j) {
       const PairKey key{holders[i], holders[j]};
       const PairAt at = *heldPair(key);
-      const auto done = results_.find(key);
-      if (done != results_.end() && isCurrent(done->second)) continue;
+      if (settled(key)) continue;
       const auto other = claims_.find(key);
       const bool live_other = other != claims_.end() && live(other->second, at, now);
       auto mine = own_claims_.find(key);
@@ -158,7 +159,25 @@ void PairBoard::computed(AgreedTransform t) {
   const PairKey key = t.pair();
   if (computing_ && computing_->pair == key) computing_.reset();
   own_claims_.erase(key);
+  store(std::move(t));
+}
+
+void PairBoard::store(AgreedTransform t) {
+  const PairKey key = t.pair();
+  const auto it = results_.find(key);
+  if (!t.reliable && it != results_.end() && it->second.reliable &&
+      !it->second.isFor(t.target_version, t.source_version)) {
+    unreliable_[key] = std::move(t);
+    return;
+  }
+  unreliable_.erase(key);
   results_[key] = std::move(t);
+}
+
+bool PairBoard::settled(const PairKey& key) const {
+  for (const auto* held : {&results_, &unreliable_})
+    if (const auto it = held->find(key); it != held->end() && isCurrent(it->second)) return true;
+  return false;
 }
 
 bool PairBoard::isCurrent(const AgreedTransform& t) const {
@@ -174,16 +193,18 @@ size_t PairBoard::currentResults() const {
 
 PairStatus PairBoard::status(const PairKey& key, Clock::time_point now) const {
   const auto done = results_.find(key);
-  if (computing_ && computing_->pair == key) return {PairState::Computing, me_};
-  if (done != results_.end() && isCurrent(done->second)) return {PairState::Agreed, done->second.computed_by};
+  if (computing_ && computing_->pair == key) return {PairState::Computing, me_, {}};
+  if (done != results_.end() && isCurrent(done->second)) return {PairState::Agreed, done->second.computed_by, {}};
+  if (const auto kept = unreliable_.find(key); kept != unreliable_.end() && isCurrent(kept->second))
+    return {PairState::Kept, kept->second.computed_by, kept->second.reason};
   const std::optional<PairAt> at = heldPair(key);
   if (at) {
-    if (const auto mine = own_claims_.find(key); mine != own_claims_.end()) return {PairState::Claimed, me_};
+    if (const auto mine = own_claims_.find(key); mine != own_claims_.end()) return {PairState::Claimed, me_, {}};
     if (const auto other = claims_.find(key); other != claims_.end() && live(other->second, *at, now))
-      return {PairState::ClaimedByPeer, other->second.claimer};
+      return {PairState::ClaimedByPeer, other->second.claimer, {}};
   }
-  if (done != results_.end()) return {PairState::Stale, done->second.computed_by};
-  return {at ? PairState::Open : PairState::WaitingForMaps, ""};
+  if (done != results_.end()) return {PairState::Stale, done->second.computed_by, {}};
+  return {at ? PairState::Open : PairState::WaitingForMaps, {}, {}};
 }
 
 std::vector<PairKey> PairBoard::pairs() const {

@@ -33,12 +33,17 @@ enum class PairState {
   Computing,       ///< our worker is matching it
   Agreed,          ///< a result for the current versions
   Stale,           ///< a result for earlier versions, and nobody on the new ones yet
+  /// The current versions gave no reliable match: the reliable result for
+  /// earlier versions stays the agreed one (an unreliable answer never
+  /// replaces a reliable one), and the pair is not computed again.
+  Kept,
 };
 const char* stateName(PairState s);
 
 struct PairStatus {
   PairState state = PairState::WaitingForMaps;
-  std::string by;  ///< the claimer (ClaimedByPeer) or the computing agent (Agreed, Stale)
+  std::string by;   ///< the claimer (ClaimedByPeer) or the computing agent (Agreed, Stale, Kept)
+  std::string why;  ///< Kept: why the current versions gave no reliable match
 };
 
 struct BoardTimings {
@@ -104,6 +109,8 @@ class PairBoard {
 
   // ---- what the fleet agreed
   const std::map<PairKey, AgreedTransform>& results() const { return results_; }
+  /// Unreliable answers for the current versions held beside an earlier reliable result (Kept).
+  const std::map<PairKey, AgreedTransform>& keptBeside() const { return unreliable_; }
   /// Whether `t` was computed for the maps' versions known now.
   bool isCurrent(const AgreedTransform& t) const;
   size_t currentResults() const;
@@ -126,6 +133,10 @@ class PairBoard {
     Clock::time_point at;
   };
   bool live(const Claim& c, const PairAt& at, Clock::time_point now) const;
+  /// Stores a result, unless it is unreliable and would replace a reliable one for earlier versions.
+  void store(AgreedTransform t);
+  /// Whether the current versions of a pair have an answer (reliable or not).
+  bool settled(const PairKey& key) const;
   std::optional<PairAt> heldPair(const PairKey& key) const;
 
   std::string me_;
@@ -138,6 +149,7 @@ class PairBoard {
   std::optional<PairAt> computing_;
   Clock::time_point claim_renewed_{};  ///< when the computing pair's claim was last published
   std::map<PairKey, AgreedTransform> results_;
+  std::map<PairKey, AgreedTransform> unreliable_;
 };
 
 }  // namespace tomomap::daemon

@@ -119,7 +119,15 @@ void printHuman(const json& status, const json& transforms, bool running) {
               << ago(static_cast<double>(t.computed_at_ms));
     const bool current =
         versions.count(t.target) && versions.count(t.source) && t.isFor(versions.at(t.target), versions.at(t.source));
-    std::cout << (current ? "" : "; STALE: a map changed since, recomputing") << "\n";
+    std::string kept;
+    for (const auto& p : status.value("pairs", json::array()))
+      if (p.value("pair", "") == t.target + "<-" + t.source && p.value("state", "") == "kept")
+        kept = p.value("why", "");
+    if (!kept.empty())
+      std::cout << "; KEPT: for earlier maps; the current ones gave no reliable match (" << kept << ")";
+    else if (!current)
+      std::cout << "; STALE: a map changed since, recomputing";
+    std::cout << "\n";
   }
 }
 

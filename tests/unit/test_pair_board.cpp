@@ -247,3 +247,47 @@ TEST(PairBoard, AnEstimateAheadOfTheAnnouncementIsHeldUntilItsVersionIsKnown) {
   EXPECT_EQ(charlie.results().at(kAB).source_version, 2u);
   EXPECT_TRUE(charlie.mapAnnounced("bravo", 5).empty()) << "the dropped one does not come back";
 }
+
+TEST(PairBoard, AnUnreliableAnswerForNewMapsDoesNotReplaceAReliableOne) {
+  // A map update that gave no reliable match (a tilted scan, a bad SLAM
+  // session) once replaced a good transform.
+  PairBoard b = holdingBoth("alpha");
+  ASSERT_EQ(b.estimateSeen(resultOf({kAB, 1, 2}, "bravo", 7.0)), PairBoard::Offer::Stored);
+  b.mapAnnounced("bravo", 3);
+  b.mapHeld("bravo");
+  AgreedTransform bad = resultOf({kAB, 1, 3}, "bravo", 99.0);
+  bad.reliable = false;
+  bad.reason = "only 2 slice pairs agree (need 3)";
+  ASSERT_EQ(b.estimateSeen(bad), PairBoard::Offer::Stored);
+
+  ASSERT_EQ(b.results().size(), 1u);
+  EXPECT_TRUE(b.results().at(kAB).reliable);
+  EXPECT_EQ(b.results().at(kAB).T_target_source.x, 7.0) << "the reliable transform stays";
+  const PairStatus s = b.status(kAB, t0);
+  EXPECT_EQ(s.state, PairState::Kept);
+  EXPECT_EQ(s.why, bad.reason);
+  // The current versions have their answer: nobody computes them again.
+  EXPECT_TRUE(b.step(t0).claims.empty());
+  EXPECT_TRUE(b.step(t0 + 20s).claims.empty());
+  EXPECT_EQ(b.estimateSeen(bad), PairBoard::Offer::Duplicate);
+
+  // A reliable answer for still newer maps replaces it as usual.
+  b.mapAnnounced("bravo", 4);
+  b.mapHeld("bravo");
+  EXPECT_EQ(b.status(kAB, t0).state, PairState::Stale) << "recomputed for version 4";
+  ASSERT_EQ(b.estimateSeen(resultOf({kAB, 1, 4}, "bravo", 8.0)), PairBoard::Offer::Stored);
+  EXPECT_EQ(b.results().at(kAB).T_target_source.x, 8.0);
+  EXPECT_EQ(b.status(kAB, t0).state, PairState::Agreed);
+  EXPECT_TRUE(b.keptBeside().empty());
+}
+
+TEST(PairBoard, WithNoReliableAnswerBeforeAnUnreliableOneIsStored) {
+  PairBoard b = holdingBoth("alpha");
+  AgreedTransform none = resultOf({kAB, 1, 2}, "bravo");
+  none.reliable = false;
+  none.reason = "ambiguous";
+  ASSERT_EQ(b.estimateSeen(none), PairBoard::Offer::Stored);
+  EXPECT_FALSE(b.results().at(kAB).reliable);
+  EXPECT_EQ(b.status(kAB, t0).state, PairState::Agreed);
+  EXPECT_TRUE(b.step(t0).claims.empty());
+}
