@@ -123,6 +123,7 @@ void Agent::onAnnouncement(wire::MapAnnouncement&& a) {
   if (owner == config_.agent() || !fromKnown(owner, "an announcement")) return;
   if (const auto why = transport::validate(a)) return reject(owner, why);
   if (const auto why = transport::fitsBudget(a, peers_.memoryBudget())) return reject(owner, why);
+  if (!sameGrid(owner, a.grid())) return;
   const uint64_t version = a.version();
   const auto done = peers_.announce(std::move(a), Clock::now());
   if (!done.new_version) return;
@@ -136,6 +137,23 @@ void Agent::onAnnouncement(wire::MapAnnouncement&& a) {
     persist(false);
   }
   if (done.request) bus_->publish(*done.request);
+}
+
+bool Agent::sameGrid(const std::string& owner, double grid) {
+  // Slices of another grid cannot be matched with ours: nothing is requested,
+  // rather than a whole map moved for a match that must fail.
+  if (std::abs(grid - config_.match.grid) <= 1e-9) {
+    if (other_grid_.erase(owner)) log_.info(owner + " now uses our grid (" + fixed(grid, 3) + " m)");
+    return true;
+  }
+  const std::string why = "its map uses grid " + fixed(grid, 3) + " m, ours " + fixed(config_.match.grid, 3) +
+                          " m: not requested, the pair cannot be matched (set the same grid on both)";
+  if (other_grid_[owner] != why) {
+    other_grid_[owner] = why;
+    log_.warning(owner + ": " + why);
+    persist(false);
+  }
+  return false;
 }
 
 void Agent::onSlice(wire::SliceFeatures&& s, size_t bytes) {

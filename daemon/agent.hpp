@@ -99,6 +99,8 @@ class Agent {
   void requestMissing(bool at_once = false);
   void claimAndCompute();
   void finishCompute();
+  /// Whether a peer's announced grid is ours; says once per peer and grid when not.
+  bool sameGrid(const std::string& owner, double grid);
   /// Says so when a stored answer did not replace the pair's reliable one.
   void logIfKept(const PairKey& pair);
   std::shared_ptr<const MapFeatures> featuresOf(const std::string& agent) const;
@@ -128,6 +130,7 @@ class Agent {
   PairBoard board_;
   MatchWorker worker_;
   Counters counters_;
+  std::map<std::string, std::string> other_grid_;  ///< peers whose map uses another grid, and what to say
   Clock::time_point last_status_{};
   RejectionLog rejections_;  ///< warnings for rejected samples, bounded per sender
   bool reannounce_ = false;  ///< a peer appeared: announce again (tick, once for peers that come together)

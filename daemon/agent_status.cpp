@@ -20,7 +20,11 @@ void Agent::persist(bool transforms_changed) {
       writeJsonAtomically((dir / "transforms.json").string(), {{"agent", config_.agent()}, {"transforms", list}});
     }
     nlohmann::json peers = nlohmann::json::object();
-    for (const auto& peer : config_.transport.peers) peers[peer.id] = peers_.status(peer);
+    for (const auto& peer : config_.transport.peers) {
+      peers[peer.id] = peers_.status(peer);
+      if (const auto it = other_grid_.find(peer.id); it != other_grid_.end())
+        peers[peer.id]["incompatible"] = it->second;
+    }
     const auto now = Clock::now();
     nlohmann::json pairs = nlohmann::json::array();
     for (const auto& key : board_.pairs()) {

@@ -99,6 +99,7 @@ void printHuman(const json& status, const json& transforms, bool running) {
                 << " kept from its previous version), " << kB(p.value("bytes_received", 0.0)) << " received"
                 << (p.value("complete", false) ? ", complete" : ", in transfer") << ", "
                 << fixed(p.value("rate_kbps", 0.0), 0) << " kbit/s";
+    if (p.contains("incompatible")) std::cout << "\n        INCOMPATIBLE: " << p["incompatible"].get<std::string>();
     std::cout << "\n";
   }
   const auto versions = currentVersions(status);

@@ -134,6 +134,36 @@ TEST(Daemons, SamplesFromAnAgentNotInTheConfigAreDroppedAndCounted) {
   stopAll(fleet, {"alpha", "bravo", "mallory"});
 }
 
+TEST(Daemons, APeerOnAnotherGridIsToldApartBeforeAnySliceMoves) {
+  // Two robots with different grid sizes once moved the whole map, then
+  // stored a zero transform marked unreliable.
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  Fleet fleet(dir);
+  const std::string d = demoRoom() + "/";
+  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd", 0.05}, {"bravo", d + "demo-pcd2.pcd", 0.1}};
+  for (const auto& a : agents) fleet.start(a, agents);
+  const auto incompatible = [&](const std::string& id, const std::string& peer) {
+    const auto status = fleet.readJson(id, "status.json");  // null until written
+    if (!status.contains("peers") || !status["peers"].contains(peer)) return std::string();
+    return status["peers"][peer].value("incompatible", std::string());
+  };
+  ASSERT_TRUE(Fleet::waitFor(
+      [&] { return !incompatible("alpha", "bravo").empty() && !incompatible("bravo", "alpha").empty(); }, 60s))
+      << fleet.log("alpha") << fleet.log("bravo");
+  EXPECT_NE(incompatible("alpha", "bravo").find("grid 0.100 m, ours 0.050 m"), std::string::npos)
+      << incompatible("alpha", "bravo");
+  for (const char* id : {"alpha", "bravo"}) {
+    const auto status = fleet.readJson(id, "status.json");
+    EXPECT_EQ(status["sent"]["bytes"], 0) << id << " was asked for nothing";
+    EXPECT_TRUE(fleet.transforms(id).empty()) << id;
+    EXPECT_EQ(countOf(fleet.log(id), "its map uses grid"), 1u) << "said once\n" << fleet.log(id);
+  }
+  const auto view = runTomomap("status " + (dir / "out-alpha"));
+  EXPECT_NE(view.output.find("INCOMPATIBLE: its map uses grid 0.100 m"), std::string::npos) << view.output;
+  stopAll(fleet, {"alpha", "bravo"});
+}
+
 TEST(Daemons, APeerMapOverTheMemoryBudgetIsRefusedAndTheDaemonStaysResponsive) {
   TempDir dir;
   // Each map fits its announcement into 1 MB but inflates to about a million

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
+#include <random>
 #include <thread>
 
 #include "core/gravity.hpp"
@@ -250,7 +251,7 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
   for (const char* id : {"alpha", "bravo"}) EXPECT_EQ(fleet.waitExit(id, 2000ms), 0);
 }
 
-TEST(Operations, ATiltedMapIsNeitherOfferedNorAllowedToReplaceTheAgreedTransform) {
+TEST(Operations, NeitherATiltedMapNorOneThatMatchesNothingReplacesTheAgreedTransform) {
   REQUIRE_DEMO_ROOM();
   TempDir dir;
   const std::string d = demoRoom() + "/";
@@ -286,8 +287,38 @@ TEST(Operations, ATiltedMapIsNeitherOfferedNorAllowedToReplaceTheAgreedTransform
     EXPECT_EQ(t.at("alpha<-bravo")["T_target_source"], agreed["T_target_source"]) << id;
     EXPECT_TRUE(t.at("alpha<-bravo")["reliable"].get<bool>()) << id;
   }
+
+  // Then a level map that matches nothing (a SLAM session gone wrong: scattered
+  // returns): offered, matched, no reliable match, and the agreed transform stays.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.0f, 5.0f);
+  Points junk;
+  for (int i = 0; i < 60000; ++i) junk.emplace_back(u(rng), u(rng), 0.6f * u(rng));
+  savePcd(dir / "bravo.pcd.tmp", junk);
+  std::filesystem::rename(dir / "bravo.pcd.tmp", bravo_map);
+  const auto kept = [&](const std::string& id) {
+    for (const auto& p : fleet.readJson(id, "status.json").value("pairs", nlohmann::json::array()))
+      if (p.value("pair", "") == "alpha<-bravo" && p.value("state", "") == "kept") return true;
+    return false;
+  };
+  ASSERT_TRUE(Fleet::waitFor([&] { return kept("alpha") && kept("bravo"); }, 60s))
+      << fleet.log("alpha") << fleet.log("bravo");
+  EXPECT_NE(fleet.readJson("bravo", "status.json")["map"]["version"], v1) << "the junk map is offered";
+  for (const char* id : {"alpha", "bravo"}) {
+    EXPECT_EQ(fleet.transforms(id).at("alpha<-bravo")["T_target_source"], agreed["T_target_source"]) << id;
+    EXPECT_NE(fleet.log(id).find("the reliable transform agreed for their earlier versions stays"), std::string::npos)
+        << fleet.log(id);
+  }
+  const auto kept_view = runTomomap("status " + (dir / "out-alpha"));
+  EXPECT_NE(kept_view.output.find("KEPT: for earlier maps"), std::string::npos) << kept_view.output;
+  int computed = 0;
+  for (const char* id : {"alpha", "bravo"}) computed += fleet.readJson(id, "status.json").value("matches_computed", 0);
+  EXPECT_EQ(computed, 2) << "the first agreement and the junk map's, once each";
+
   for (const char* id : {"alpha", "bravo"}) fleet.kill(id, SIGTERM);
   for (const char* id : {"alpha", "bravo"}) EXPECT_EQ(fleet.waitExit(id, 2000ms), 0);
+  savePcd(dir / "bravo.pcd.tmp", rolled);
+  std::filesystem::rename(dir / "bravo.pcd.tmp", bravo_map);
 
   // Started on the leaning map, the daemon refuses it and says why: exit 2, which systemd does not restart.
   fleet.start(agents[1], agents);
