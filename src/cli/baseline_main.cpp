@@ -3,6 +3,7 @@
 // stack neither slows down nor inflates the memory of `tomomap` itself, and so
 // that evaluations measure each method's memory on its own.
 #include "baseline/fpfh_ransac.hpp"
+#include "grid_option.hpp"
 #include "io/map_io.hpp"
 #include "report.hpp"
 #include "run_guarded.hpp"
@@ -21,9 +22,7 @@ int main(int argc, char** argv) {
   baseline::FpfhParams p;
   app.add_option("TARGET", target, "target map (.pcd, .ply, .xyz/.txt)")->required();
   app.add_option("SOURCE", source, "source map")->required();
-  app.add_option("-g,--grid", p.grid, "grid size g [m]; radii scale with it")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+  app.add_option("-g,--grid", p.grid, "grid size g [m]; radii scale with it")->capture_default_str()->check(gridSize());
   app.add_option("--keypoint-cells", p.keypoint_cells, "keypoint spacing [g]: fewer keypoints run faster")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 100.0));
@@ -52,7 +51,7 @@ int main(int argc, char** argv) {
     r.source_features = b.source_keypoints;
     r.timings.features = b.describe_seconds;
     r.timings.pair_matching = b.ransac_seconds;
-    return report(r, P_target, P_source, p.grid, json, /*baseline=*/true,
+    return report(r, P_target, P_source, p.grid, {json, /*baseline=*/true, false},
                   {{"target_points", t.size()}, {"source_points", s.size()}});
   });
 }

@@ -160,7 +160,16 @@ Command addStatusCommand(CLI::App& app) {
       "Exit codes: 0 running, 1 not running (the files are from an earlier run), 2 no readable state.");
   sub->add_option("state_dir", o->dir, "the daemon's output_dir (the service's StateDirectory)")->capture_default_str();
   sub->add_flag("--json", o->json, "print one JSON document for scripts instead of text");
-  return {sub, [o] { return runStatus(*o); }};
+  return {sub, [o] {
+            if (!o->json) return runStatus(*o);
+            // A script reads stdout: it gets a document even when there is no state.
+            try {
+              return runStatus(*o);
+            } catch (const InputError& e) {
+              std::cout << json{{"running", false}, {"error", e.what()}}.dump(2) << "\n";
+              throw;
+            }
+          }};
 }
 
 }  // namespace tomomap::cli

@@ -5,12 +5,14 @@
 
 #include "core/map_bounds.hpp"
 #include "core/text.hpp"
+#include "grid_option.hpp"
 #include "io/map_io.hpp"
 #include "progress.hpp"
 
 namespace tomomap::cli {
 
-MatchedFiles matchFiles(const MatchFilesOptions& o) {
+MatchedFiles matchFiles(MatchFilesOptions o) {
+  if (o.json == "-") o.quiet = true;  // stdout is the JSON's alone
   if (!(o.params.grid > 0.0)) throw InputError("grid size must be positive");
   MatchParams params = o.params;
   params.max_tilt = radians(o.max_tilt_deg);
@@ -48,7 +50,9 @@ MatchedFiles matchFiles(const MatchFilesOptions& o) {
 void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
   sub.add_option("-g,--grid", o.params.grid, "grid size g [m]: voxel, pixel and slice size")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(gridSize());
+  sub.add_option("--json", o.json,
+                 "also write the result as JSON to FILE (- for stdout; the text then goes to stderr)");
   sub.add_option("--gt-target", o.gt_target, "target's ground-truth pose file (3x4 row-major)");
   sub.add_option("--gt-source", o.gt_source, "source's ground-truth pose file (3x4 row-major)");
   sub.add_option("--features", o.params.features.max_features, "ORB keypoints kept per slice")
@@ -62,7 +66,7 @@ void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
       ->check(CLI::Range(0.0, 90.0));
   sub.add_flag("--level", o.params.level, "level a tilted map (turn its up onto z) instead of refusing it");
   sub.add_flag("--progress", o.progress, "show progress even when stderr is not a terminal");
-  sub.add_flag("-q,--quiet", o.quiet, "print only the result");
+  sub.add_flag("-q,--quiet", o.quiet, "print only the result, one line");
 }
 
 }  // namespace tomomap::cli

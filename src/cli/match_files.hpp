@@ -11,6 +11,7 @@ namespace tomomap::cli {
 
 struct MatchFilesOptions {
   std::string target, source, gt_target, gt_source;
+  std::string json;  ///< where to write the result as JSON ("-": stdout)
   MatchParams params;
   double max_tilt_deg = degrees(MatchParams{}.max_tilt);
   bool progress = false, quiet = false;
@@ -26,9 +27,9 @@ struct MatchedFiles {
 /// Reads the ground truth first (so a bad pose file fails before minutes of
 /// work), then each map in turn (its raw points are dropped once described,
 /// which halves peak memory on large maps), then matches.
-MatchedFiles matchFiles(const MatchFilesOptions& o);
+MatchedFiles matchFiles(MatchFilesOptions o);
 
-/// Adds --grid, --gt-target, --gt-source, --features, -j, --progress, -q.
+/// Adds --grid, --json, --gt-target, --gt-source, --features, -j, --max-tilt, --level, --progress, -q.
 void addMatchOptions(CLI::App& sub, MatchFilesOptions& o);
 
 }  // namespace tomomap::cli

@@ -49,16 +49,19 @@ GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const Eigen::Matr
   return c;
 }
 
-void printResult(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& gt, bool baseline) {
+std::string resultLine(const MatchResult& r) {
   const auto& T = r.T_target_source;
+  if (!r.reliable) return "no reliable match: " + r.reason;
+  return format("T_target_source  x %.4f  y %.4f  z %.4f m  yaw %.4f rad (%.2f deg)", T.x, T.y, T.z, T.yaw,
+                degrees(T.yaw));
+}
+
+void printResult(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& gt, bool baseline) {
+  out << resultLine(r) << "\n";
   if (r.reliable) {
-    out << format("T_target_source  x %.4f  y %.4f  z %.4f m  yaw %.4f rad (%.2f deg)\n", T.x, T.y, T.z, T.yaw,
-                  degrees(T.yaw));
     if (r.T_target_source_unleveled) out << "  between the levelled maps; in the maps' own frames:\n";
     const Eigen::Matrix4d M = r.matrix();
     for (int i = 0; i < 4; ++i) out << format("  [%9.5f %9.5f %9.5f %9.4f]\n", M(i, 0), M(i, 1), M(i, 2), M(i, 3));
-  } else {
-    out << "no reliable match: " << r.reason << "\n";
   }
   if (baseline) {
     out << format("keypoints        target %zu, source %zu, %zu inliers\n", r.target_features, r.source_features,
@@ -123,18 +126,27 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
 }
 
 int report(const MatchResult& r, const std::optional<Eigen::Matrix4d>& P_target,
-           const std::optional<Eigen::Matrix4d>& P_source, double grid, const std::string& json, bool baseline,
+           const std::optional<Eigen::Matrix4d>& P_source, double grid, const ReportOptions& how,
            const nlohmann::json& extra) {
   std::optional<GroundTruthCheck> gt;
   if (P_target && P_source) gt = checkAgainstGroundTruth(r, *P_target, *P_source, grid);
-  printResult(std::cout, r, gt, baseline);
-  if (!json.empty()) {
-    std::ofstream out(json);
+  const bool json_to_stdout = how.json == "-";
+  std::ostream& text = json_to_stdout ? std::cerr : std::cout;
+  if (how.quiet)
+    text << resultLine(r) << "\n";
+  else
+    printResult(text, r, gt, how.baseline);
+  if (!how.json.empty()) {
     auto j = toJson(r, gt);
-    j["method"] = baseline ? "fpfh-ransac" : "tomomap";
+    j["method"] = how.baseline ? "fpfh-ransac" : "tomomap";
     if (extra.is_object()) j.update(extra);
-    out << j.dump(2) << "\n";
-    if (!out) throw InputError(json + ": cannot write JSON result");
+    if (json_to_stdout) {
+      std::cout << j.dump(2) << "\n";
+    } else {
+      std::ofstream out(how.json);
+      out << j.dump(2) << "\n";
+      if (!out) throw InputError(how.json + ": cannot write JSON result");
+    }
   }
   return r.reliable ? kExitOk : kExitNoMatch;
 }

@@ -26,11 +26,22 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
 
 nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck>& gt);
 
+/// How a result is reported: `json` a file to write the JSON to ("-":
+/// stdout, the text then goes to stderr), `quiet` the text as one line.
+struct ReportOptions {
+  std::string json;
+  bool baseline = false;
+  bool quiet = false;
+};
+
 /// Prints the result (and its error against ground truth when both poses are
-/// given), writes the JSON file when `json` is not empty, and returns the exit code.
+/// given), writes the JSON when asked, and returns the exit code.
 int report(const MatchResult& r, const std::optional<Eigen::Matrix4d>& P_target,
-           const std::optional<Eigen::Matrix4d>& P_source, double grid, const std::string& json, bool baseline,
+           const std::optional<Eigen::Matrix4d>& P_source, double grid, const ReportOptions& how,
            const nlohmann::json& extra = {});
+
+/// One line: the transform, or "no reliable match: REASON".
+std::string resultLine(const MatchResult& r);
 
 /// Throws InputError unless both ground-truth options or neither are given.
 void requireBothOrNeither(const std::string& gt_target, const std::string& gt_source);

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "map_bounds.hpp"
+#include "text.hpp"
 
 namespace tomomap {
 
@@ -28,11 +29,15 @@ SliceStack makeSlices(const Points& points, double cell) {
   g.z_min = lo.z();
   const double w = std::floor((hi.x() - lo.x()) / cell) + 1, h = std::floor((hi.y() - lo.y()) / cell) + 1;
   const double n = std::ceil((hi.z() - lo.z()) / cell - 0.5) + 1;
-  if (w > kMaxImageSide || h > kMaxImageSide || n > kMaxImageSide)
-    throw InputError("grid size " + std::to_string(cell) + " m is too fine for a map of " +
-                     std::to_string(hi.x() - lo.x()) + " x " + std::to_string(hi.y() - lo.y()) + " x " +
-                     std::to_string(hi.z() - lo.z()) + " m (more than " + std::to_string(kMaxImageSide) +
-                     " cells along one axis)");
+  if (w > kMaxImageSide || h > kMaxImageSide || n > kMaxImageSide) {
+    const Eigen::Vector3f size = hi - lo;
+    // A building is not kilometres tall: such a map is most likely in millimetres.
+    const std::string units =
+        size.z() > 1000.0f ? "; a map this tall is likely in millimetres: scale it to metres" : "";
+    throw InputError("grid size " + fixed(cell, 4) + " m is too fine for a map of " + fixed(size.x(), 1) + " x " +
+                     fixed(size.y(), 1) + " x " + fixed(size.z(), 1) + " m (more than " +
+                     std::to_string(kMaxImageSide) + " cells along one axis)" + units);
+  }
   g.width = static_cast<int>(w);
   g.height = static_cast<int>(h);
 

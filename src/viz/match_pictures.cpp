@@ -124,8 +124,9 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
   const SliceGrid& sg = source.occupancy.grid;
   const Rigid2D T{r.T_target_source.yaw, {r.T_target_source.x, r.T_target_source.y}};
   const int pad = 8;
+  int drawn_pairs = 0;
   for (const auto& pair : r.supporters) {
-    if (static_cast<int>(rows.size()) >= count) break;
+    if (drawn_pairs >= count) break;
     const SliceFeatures* ft = findSlice(target, pair.target_slice);
     const SliceFeatures* fs = findSlice(source, pair.source_slice);
     if (!ft || !fs || pair.target_slice >= target.occupancy.size() || pair.source_slice >= source.occupancy.size())
@@ -174,6 +175,7 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
     rows.push_back(header);
     rows.push_back(drawn);
     rows.push_back(cv::Mat(16, drawn.cols, CV_8UC3, colour::kWhite));
+    ++drawn_pairs;
   }
   if (rows.empty()) {
     cv::Mat none(80, 700, CV_8UC3, colour::kWhite);

@@ -311,3 +311,62 @@ TEST(Cli, ATiltedSynthMapIsRefusedAndLevelledOnRequest) {
   EXPECT_LT(l["error"]["yaw"].get<double>(), radians(1.0)) << "the whole rotation, roll included";
   EXPECT_TRUE(l.contains("T_target_source_unleveled"));
 }
+
+TEST(Cli, VizDrawsAsManySlicePairsAsAskedAndWritesJson) {
+  // --pairs 3 once drew one pair (three image rows were counted per pair).
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  std::string args = demoMatchArgs();
+  args.replace(0, 5, "viz");
+  ASSERT_EQ(runTomomap(args + " -o " + (dir / "one") + " --pairs 1").exit_code, 0);
+  const auto three = runTomomap(args + " -o " + (dir / "three") + " --pairs 3 --json " + (dir / "viz.json"));
+  ASSERT_EQ(three.exit_code, 0) << three.output;
+  const cv::Mat a = cv::imread(dir / "one/slice-pairs.png"), b = cv::imread(dir / "three/slice-pairs.png");
+  ASSERT_FALSE(a.empty());
+  ASSERT_FALSE(b.empty());
+  EXPECT_GT(b.rows, 2.5 * a.rows) << "three pairs stacked, not one";
+  EXPECT_TRUE(nlohmann::json::parse(std::ifstream(dir / "viz.json"))["reliable"].get<bool>());
+}
+
+TEST(Cli, QuietIsOneLineJsonGoesToStdoutAndTyposGetASuggestion) {
+  REQUIRE_DEMO_ROOM();
+  const auto quiet = runTomomap(demoMatchArgs() + " -q");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
+  EXPECT_EQ(lines(quiet.output), 1u) << quiet.output;
+  EXPECT_EQ(quiet.output.rfind("T_target_source  x ", 0), 0u) << quiet.output;
+
+  // The text goes to stderr, stdout is one JSON document.
+  const auto piped = runTomomap(demoMatchArgs() + " -q --json -");
+  ASSERT_EQ(piped.exit_code, 0) << piped.output;
+  const auto j = nlohmann::json::parse(piped.output.substr(piped.output.find('{')));
+  EXPECT_TRUE(j["reliable"].get<bool>());
+  EXPECT_FALSE(std::filesystem::exists("-")) << "no file named '-'";
+
+  const auto typo = runTomomap("mtach a.pcd b.pcd");
+  EXPECT_EQ(typo.exit_code, 2);
+  EXPECT_NE(typo.output.find("unknown command 'mtach'; did you mean 'match'?"), std::string::npos) << typo.output;
+
+  const auto zero = runTomomap(demoMatchArgs() + " --grid 0");
+  EXPECT_EQ(zero.exit_code, 2);
+  EXPECT_NE(zero.output.find("grid size must be a positive number of metres"), std::string::npos) << zero.output;
+  EXPECT_LT(zero.output.size(), 300u) << zero.output;
+}
+
+TEST(Cli, AMapInMillimetresGetsAHintAndStatusJsonAlwaysPrintsADocument) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  Points mm = loadMap(demo("demo-pcd2.pcd"));
+  for (auto& p : mm) p *= 1000.0f;
+  savePcd(dir / "mm.pcd", mm);
+  const auto r = runTomomap("match " + demo("demo-pcd1.pcd") + " " + (dir / "mm.pcd"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("likely in millimetres"), std::string::npos) << r.output;
+
+  const auto none = runTomomap("status --json " + (dir / "no-state"));
+  EXPECT_EQ(none.exit_code, 2);
+  const size_t open = none.output.find('{'), close = none.output.rfind('}');
+  ASSERT_NE(open, std::string::npos) << none.output;
+  const auto j = nlohmann::json::parse(none.output.substr(open, close - open + 1));
+  EXPECT_FALSE(j["running"].get<bool>());
+  EXPECT_NE(j["error"].get<std::string>().find("cannot read"), std::string::npos);
+}
