@@ -23,7 +23,9 @@ const double kClassCone = radians(30.0);
 constexpr int kRounds = 4;
 /// Fewer flat patches than this and the tilt is not measured.
 constexpr size_t kMinPatches = 20;
+/// Estimates, each in the frame the previous ones levelled (see estimateTilt).
 constexpr int kPasses = 3;
+/// Points looked at, at most: the large surfaces show in a sample.
 constexpr size_t kMaxPoints = 500000;
 
 struct Patch {
