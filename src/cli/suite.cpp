@@ -7,6 +7,7 @@
 #include <set>
 
 #include "core/types.hpp"
+#include "synth/scene.hpp"
 
 namespace tomomap::cli {
 namespace {
@@ -114,8 +115,11 @@ Suite loadSuite(const std::string& path) {
       checkKeys(path, *t, {"world", "seeds", "noise", "scale", "grid", "methods"}, "[[synth]]");
       SuiteSynth y;
       y.world = text(path, *t, "world", "[[synth]]");
-      if (y.world != "indoor" && y.world != "outdoor")
-        fail(path, t->get("world")->source(), "unknown world '" + y.world + "'");
+      try {
+        synth::parseWorldType(y.world);
+      } catch (const InputError& bad) {
+        fail(path, t->get("world")->source(), bad.what());
+      }
       y.seeds = list<int64_t>(path, *t, "seeds", y.seeds);
       y.noise = list<std::string>(path, *t, "noise", y.noise);
       for (const auto& n : y.noise)

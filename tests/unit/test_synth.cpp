@@ -83,7 +83,7 @@ TEST_P(SynthWorld, OtherSeedOtherWorld) {
   EXPECT_TRUE(makeScene(a).world.boxes.back().lo.isApprox(sa.world.boxes.back().lo));
 }
 
-INSTANTIATE_TEST_SUITE_P(Types, SynthWorld, ::testing::Values(WorldType::Indoor, WorldType::Outdoor),
+INSTANTIATE_TEST_SUITE_P(Types, SynthWorld, ::testing::Values(WorldType::Indoor, WorldType::Outdoor, WorldType::Room),
                          [](const auto& p) { return toString(p.param); });
 
 TEST(Synth, BadNamesAreInputErrors) {
