@@ -25,8 +25,8 @@ void Agent::post(std::function<void()> work) {
 namespace {
 
 std::string tiltText(const MapFeatures& f) {
-  if (!f.tilt.measured) return "tilt not measurable (too few flat surfaces)";
-  return (f.leveled ? "levelled: it leaned " : "tilt ") + fixed(degrees(f.tilt.angle), 1) + " deg";
+  return f.tilt.measured ? "tilt " + fixed(degrees(f.tilt.angle), 1) + " deg"
+                         : "tilt not measurable (too few flat surfaces)";
 }
 
 }  // namespace

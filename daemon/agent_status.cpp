@@ -50,7 +50,6 @@ void Agent::persist(bool transforms_changed) {
           {"updating", describing_.valid()},
           {"tilt_deg",
            own_features_->tilt.measured ? nlohmann::json(degrees(own_features_->tilt.angle)) : nlohmann::json()},
-          {"leveled", own_features_->leveled},
           {"update_refused", map_refused_},
           {"slices", a.slices().size()},
           {"payload_bytes", offer.payload_bytes},

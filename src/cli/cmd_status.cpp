@@ -81,8 +81,7 @@ void printHuman(const json& status, const json& transforms, bool running) {
             << " % of the map's binary PCD)" << (map.value("updating", false) ? ", an update is being described" : "")
             << "\n";
   if (map.contains("tilt_deg") && map["tilt_deg"].is_number())
-    std::cout << "           " << (map.value("leveled", false) ? "levelled, it leaned " : "tilt ")
-              << fixed(map["tilt_deg"].get<double>(), 1) << " deg\n";
+    std::cout << "           tilt " << fixed(map["tilt_deg"].get<double>(), 1) << " deg\n";
   if (!map.value("update_refused", std::string()).empty())
     std::cout << "           the map file's new content is NOT offered: " << map["update_refused"].get<std::string>()
               << "\n";
