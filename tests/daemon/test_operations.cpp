@@ -102,6 +102,31 @@ void replaceIn(const std::string& path, const std::string& from, const std::stri
   std::ofstream(path) << text;
 }
 
+/// Writes `points` beside `path` and renames them over it, as a SLAM system
+/// replaces its map file in one step.
+void replaceMap(const std::string& path, const Points& points) {
+  savePcd(path + ".tmp", points);
+  std::filesystem::rename(path + ".tmp", path);
+}
+
+/// Matches computed across the fleet, from each daemon's status.
+int matchesComputed(const Fleet& fleet, const std::vector<std::string>& ids) {
+  int n = 0;
+  for (const auto& id : ids) n += fleet.readJson(id, "status.json").value("matches_computed", 0);
+  return n;
+}
+
+/// alpha on demo-pcd1 and bravo on a copy of demo-pcd2 in `dir` (bravo.pcd,
+/// where a test can rewrite it), started and agreed on their pair.
+std::vector<AgentSpec> startDemoPairWithBravosMapInDir(Fleet& fleet, const TempDir& dir, const Points& bravo) {
+  const std::string d = demoRoom() + "/";
+  savePcd(dir / "bravo.pcd", bravo);
+  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd"}, {"bravo", dir / "bravo.pcd"}};
+  for (const auto& a : agents) fleet.start(a, agents);
+  EXPECT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 60s)) << fleet.log("alpha") << fleet.log("bravo");
+  return agents;
+}
+
 Pose4 poseOf(const nlohmann::json& t) {
   const auto& T = t["T_target_source"];
   return {T["x"].get<double>(), T["y"].get<double>(), T["z"].get<double>(), T["yaw"].get<double>()};
@@ -182,11 +207,9 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
   // bravo's SLAM map lives in the test folder, where the test can rewrite it.
   const Points original = loadMap(d + "demo-pcd2.pcd");
   const std::string bravo_map = dir / "bravo.pcd";
-  savePcd(bravo_map, original);
   Fleet fleet(dir);
-  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd"}, {"bravo", bravo_map}};
-  for (const auto& a : agents) fleet.start(a, agents);
-  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 60s)) << fleet.log("alpha") << fleet.log("bravo");
+  startDemoPairWithBravosMapInDir(fleet, dir, original);
+  if (HasFailure()) return;
   const std::string v1 = fleet.readJson("bravo", "status.json")["map"]["version"];
   const size_t sent_first = fleet.readJson("bravo", "status.json")["sent"]["bytes"];
 
@@ -243,25 +266,18 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
       << view.output;
   EXPECT_EQ(view.output.find("STALE"), std::string::npos) << "the agreed transform is for the current maps";
   // One computation per version of the pair, fleet-wide.
-  int computed = 0;
-  for (const char* id : {"alpha", "bravo"}) computed += fleet.readJson(id, "status.json").value("matches_computed", 0);
-  EXPECT_EQ(computed, 2);
-
-  for (const char* id : {"alpha", "bravo"}) fleet.kill(id, SIGTERM);
-  for (const char* id : {"alpha", "bravo"}) EXPECT_EQ(fleet.waitExit(id, 2000ms), 0);
+  EXPECT_EQ(matchesComputed(fleet, {"alpha", "bravo"}), 2);
+  stopAll(fleet, {"alpha", "bravo"});
 }
 
 TEST(Operations, NeitherATiltedMapNorOneThatMatchesNothingReplacesTheAgreedTransform) {
   REQUIRE_DEMO_ROOM();
   TempDir dir;
-  const std::string d = demoRoom() + "/";
-  const Points original = loadMap(d + "demo-pcd2.pcd");
+  const Points original = loadMap(demoRoom() + "/demo-pcd2.pcd");
   const std::string bravo_map = dir / "bravo.pcd";
-  savePcd(bravo_map, original);
   Fleet fleet(dir);
-  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd"}, {"bravo", bravo_map}};
-  for (const auto& a : agents) fleet.start(a, agents);
-  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 60s)) << fleet.log("alpha") << fleet.log("bravo");
+  const auto agents = startDemoPairWithBravosMapInDir(fleet, dir, original);
+  if (HasFailure()) return;
   EXPECT_NE(fleet.log("bravo").find("; tilt 0."), std::string::npos) << "the own map's tilt is logged\n"
                                                                      << fleet.log("bravo");
   const auto status = fleet.readJson("bravo", "status.json");
@@ -272,8 +288,7 @@ TEST(Operations, NeitherATiltedMapNorOneThatMatchesNothingReplacesTheAgreedTrans
   // The SLAM system restarts with its first IMU frame leaning 5 degrees.
   const Points rolled =
       rotatePoints(original, Eigen::Quaterniond(Eigen::AngleAxisd(radians(5), Eigen::Vector3d::UnitX())));
-  savePcd(dir / "bravo.pcd.tmp", rolled);
-  std::filesystem::rename(dir / "bravo.pcd.tmp", bravo_map);
+  replaceMap(bravo_map, rolled);
   ASSERT_TRUE(Fleet::waitFor(
       [&] { return !fleet.readJson("bravo", "status.json")["map"].value("update_refused", "").empty(); }, 60s))
       << fleet.log("bravo");
@@ -294,8 +309,7 @@ TEST(Operations, NeitherATiltedMapNorOneThatMatchesNothingReplacesTheAgreedTrans
   std::uniform_real_distribution<float> u(0.0f, 5.0f);
   Points junk;
   for (int i = 0; i < 60000; ++i) junk.emplace_back(u(rng), u(rng), 0.6f * u(rng));
-  savePcd(dir / "bravo.pcd.tmp", junk);
-  std::filesystem::rename(dir / "bravo.pcd.tmp", bravo_map);
+  replaceMap(bravo_map, junk);
   const auto kept = [&](const std::string& id) {
     for (const auto& p : fleet.readJson(id, "status.json").value("pairs", nlohmann::json::array()))
       if (p.value("pair", "") == "alpha<-bravo" && p.value("state", "") == "kept") return true;
@@ -311,14 +325,9 @@ TEST(Operations, NeitherATiltedMapNorOneThatMatchesNothingReplacesTheAgreedTrans
   }
   const auto kept_view = runTomomap("status " + (dir / "out-alpha"));
   EXPECT_NE(kept_view.output.find("KEPT: for earlier maps"), std::string::npos) << kept_view.output;
-  int computed = 0;
-  for (const char* id : {"alpha", "bravo"}) computed += fleet.readJson(id, "status.json").value("matches_computed", 0);
-  EXPECT_EQ(computed, 2) << "the first agreement and the junk map's, once each";
-
-  for (const char* id : {"alpha", "bravo"}) fleet.kill(id, SIGTERM);
-  for (const char* id : {"alpha", "bravo"}) EXPECT_EQ(fleet.waitExit(id, 2000ms), 0);
-  savePcd(dir / "bravo.pcd.tmp", rolled);
-  std::filesystem::rename(dir / "bravo.pcd.tmp", bravo_map);
+  EXPECT_EQ(matchesComputed(fleet, {"alpha", "bravo"}), 2) << "the first agreement and the junk map's, once each";
+  stopAll(fleet, {"alpha", "bravo"});
+  replaceMap(bravo_map, rolled);
 
   // Started on the leaning map, the daemon refuses it and says why: exit 2, which systemd does not restart.
   fleet.start(agents[1], agents);
