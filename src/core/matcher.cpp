@@ -73,12 +73,11 @@ void judge(MatchResult& r, const MatchParams& params) {
 
 std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string& role, const MatchParams& params) {
   if (map.leveled || !map.tilt.measured || map.tilt.angle <= params.max_tilt) return std::nullopt;
-  if (params.level)
-    return role + " map is tilted " + fixed(degrees(map.tilt.angle), 1) +
-           " deg from gravity, too far to level (limit " + fixed(degrees(kMaxLevelable), 0) +
+  const std::string tilted = role + " map is tilted " + fixed(degrees(map.tilt.angle), 1) + " deg from gravity";
+  if (params.level)  // asked to level, and still tilted: beyond what levelling trusts
+    return tilted + ", too far to level (limit " + fixed(degrees(kMaxLevelable), 0) +
            " deg): its axes may be swapped (y up); fix its frame";
-  return role + " map is tilted " + fixed(degrees(map.tilt.angle), 1) + " deg from gravity (limit " +
-         fixed(degrees(params.max_tilt), 1) +
+  return tilted + " (limit " + fixed(degrees(params.max_tilt), 1) +
          " deg): its slices would cut walls at a slant; level it first (tomomap match --level)";
 }
 
@@ -116,9 +115,10 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   r.source_features = source.featureCount();
   r.target_tilt = target.tilt.measured ? target.tilt.angle : -1.0;
   r.source_tilt = source.tilt.measured ? source.tilt.angle : -1.0;
-  if (auto why = tiltRefusal(target, "target", params).value_or(tiltRefusal(source, "source", params).value_or(""));
-      !why.empty()) {
-    r.reason = std::move(why);
+  auto tilted = tiltRefusal(target, "target", params);
+  if (!tilted) tilted = tiltRefusal(source, "source", params);
+  if (tilted) {
+    r.reason = std::move(*tilted);
     return r;
   }
   if (std::abs(target.grid - source.grid) > 1e-9)
