@@ -2,17 +2,21 @@
 
 namespace tomomap {
 
+bool agree(const Rigid2D& a, const Rigid2D& b, const ConsensusParams& params, const Eigen::Vector2d& pivot) {
+  return (a.apply(pivot) - b.apply(pivot)).squaredNorm() <=
+             params.translation_tolerance * params.translation_tolerance &&
+         std::abs(wrapAngle(a.yaw - b.yaw)) <= params.yaw_tolerance;
+}
+
 Consensus findConsensus(const std::vector<Rigid2D>& estimates, const ConsensusParams& params,
                         const std::vector<double>& weights) {
   Consensus best;
   double best_weight = -1;
-  const double t2 = params.translation_tolerance * params.translation_tolerance;
   for (size_t a = 0; a < estimates.size(); ++a) {
     std::vector<size_t> group;
     double weight = 0;
     for (size_t b = 0; b < estimates.size(); ++b) {
-      if ((estimates[b].t - estimates[a].t).squaredNorm() <= t2 &&
-          std::abs(wrapAngle(estimates[b].yaw - estimates[a].yaw)) <= params.yaw_tolerance) {
+      if (agree(estimates[b], estimates[a], params)) {
         group.push_back(b);
         weight += weights.empty() ? 1.0 : weights[b];
       }

@@ -9,6 +9,12 @@ struct ConsensusParams {
   double yaw_tolerance = radians(10.0);  ///< [rad]
 };
 
+/// Whether two estimates are within tolerance of each other (the same answer):
+/// their yaws, and where they put `pivot`. Translations alone would part two
+/// estimates whose yaws differ by a little, far from the origin.
+bool agree(const Rigid2D& a, const Rigid2D& b, const ConsensusParams& params,
+           const Eigen::Vector2d& pivot = Eigen::Vector2d::Zero());
+
 struct Consensus {
   Rigid2D mean;                    ///< average of the supporters (yaw via mean sin/cos)
   std::vector<size_t> supporters;  ///< indices into the estimates; size() is the support

@@ -11,6 +11,14 @@ size_t MapFeatures::featureCount() const {
   return n;
 }
 
+Eigen::Vector2d MapFeatures::centre() const {
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (const auto& s : slices)
+    for (const auto& k : s.keypoints) sum += k.cast<double>();
+  const size_t n = featureCount();
+  return n ? Eigen::Vector2d(sum / static_cast<double>(n)) : sum;
+}
+
 MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params) {
   MapFeatures out;
   out.grid = stack.grid.cell;

@@ -35,6 +35,7 @@ struct MapFeatures {
 
   double sliceHeight(int k) const { return z_min + k * grid; }
   size_t featureCount() const;
+  Eigen::Vector2d centre() const;  ///< mean x, y of the keypoints [m]
 };
 
 /// Detects ORB on every non-empty slice. Parallel over slices. The stack moves

@@ -5,6 +5,17 @@
 
 namespace tomomap {
 
+namespace {
+
+ConsensusParams consensusParams(const MatchParams& params) {
+  ConsensusParams cp;
+  cp.translation_tolerance = params.consensus_translation_cells * params.grid;
+  cp.yaw_tolerance = params.consensus_yaw;
+  return cp;
+}
+
+}  // namespace
+
 std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeatures& target, const MapFeatures& source,
                                       const MatchParams& params) {
   // Each (target, source) slice pair belongs to exactly one height offset.
@@ -12,9 +23,7 @@ std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeat
   for (size_t k = 0; k < table.estimates.size(); ++k)
     if (table.estimates[k].ok)
       by_offset[target.slices[k / table.ns].index - source.slices[k % table.ns].index].push_back(k);
-  ConsensusParams cp;
-  cp.translation_tolerance = params.consensus_translation_cells * params.grid;
-  cp.yaw_tolerance = params.consensus_yaw;
+  const ConsensusParams cp = consensusParams(params);
   std::vector<OffsetScore> scores;
   for (const auto& [offset, members] : by_offset) {
     std::vector<Rigid2D> estimates;
@@ -33,18 +42,24 @@ std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeat
   return scores;
 }
 
-OffsetChoice pickOffset(const std::vector<OffsetScore>& scores) {
+OffsetChoice pickOffset(const std::vector<OffsetScore>& scores, const MatchParams& params,
+                        const Eigen::Vector2d& source_centre) {
   OffsetChoice c;
   if (scores.empty()) return c;
   c.best = &*std::max_element(scores.begin(), scores.end(), [](const OffsetScore& x, const OffsetScore& y) {
     if (x.consensus.support() != y.consensus.support()) return x.consensus.support() < y.consensus.support();
     return x.inlier_sum < y.inlier_sum;
   });
-  for (const auto& s : scores)
-    if (std::abs(s.offset - c.best->offset) > 1 && static_cast<int>(s.consensus.support()) > c.runner_up_support) {
+  const ConsensusParams cp = consensusParams(params);
+  for (const auto& s : scores) {
+    const int apart = std::abs(s.offset - c.best->offset);
+    const bool other_answer =
+        apart > kSmearSlices || (apart > 1 && !agree(s.consensus.mean, c.best->consensus.mean, cp, source_centre));
+    if (other_answer && static_cast<int>(s.consensus.support()) > c.runner_up_support) {
       c.runner_up_support = static_cast<int>(s.consensus.support());
       c.runner_up_offset = s.offset;
     }
+  }
   return c;
 }
 

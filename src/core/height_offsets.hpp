@@ -19,12 +19,22 @@ struct OffsetScore {
 std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeatures& target, const MapFeatures& source,
                                       const MatchParams& params);
 
+/// Within this many slices of the winner, an offset whose consensus has the
+/// winner's own transform is that alignment smeared over height (walls look
+/// alike a few slices up or down), not another answer.
+constexpr int kSmearSlices = 10;
+
 struct OffsetChoice {
   const OffsetScore* best = nullptr;  ///< most support, then most inliers; null when there are no scores
-  int runner_up_support = 0;          ///< best support more than one step away from the winner
-  int runner_up_offset = 0;           ///< its height offset [slices]
+  /// The best other answer: an offset more than one step from the winner that
+  /// is either beyond kSmearSlices or has a transform the winner's consensus
+  /// would not accept (a wrong hypothesis repeated over a few similar slices).
+  int runner_up_support = 0;
+  int runner_up_offset = 0;  ///< its height offset [slices]
 };
 
-OffsetChoice pickOffset(const std::vector<OffsetScore>& scores);
+/// `source_centre` is where transforms are compared (see agree()).
+OffsetChoice pickOffset(const std::vector<OffsetScore>& scores, const MatchParams& params,
+                        const Eigen::Vector2d& source_centre);
 
 }  // namespace tomomap

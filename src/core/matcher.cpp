@@ -29,18 +29,16 @@ Eigen::Vector3d inlierSpread(const Refined& r) {
   return (sq / static_cast<double>(r.inliers.size()) - mean.cwiseProduct(mean)).cwiseMax(0.0).cwiseSqrt();
 }
 
-/// Whether another height explains the maps about as well as the winner. In
-/// 18 right matches (synth indoor/outdoor at low and high noise, demo-room
-/// both ways) the runner-up sat 2-5 slices from the winner, the same
-/// alignment smeared over height, with as little as 1.04 x less support; so
-/// closeness in support alone does not tell. A runner-up many slices away
-/// with nearly the winner's support is another answer (two identical floors
-/// gave 30 vs 29 slice pairs 80 slices apart).
-bool ambiguous(const MatchResult& r) {
-  constexpr int kSmearSlices = 10;      ///< nearer: the winner's own alignment
-  constexpr double kClearAhead = 1.25;  ///< a far runner-up must have less than 1 / this of the support
-  return std::abs(r.runner_up_offset - r.height_offset) > kSmearSlices &&
-         static_cast<double>(r.support) < kClearAhead * static_cast<double>(r.runner_up_support);
+/// Whether another answer (see OffsetChoice) explains the maps about as well as
+/// the winner. Its lead must itself be a reliable support: on small rooms a
+/// wrong transform, repeated over a few similar slices, won 3-5 to 2-4 against
+/// another wrong one, while right matches (synth indoor and outdoor, seeds
+/// 1-4 at every noise level, demo-room both ways at g 0.05-0.15) led by 4 or
+/// more. And it must lead by a share: two identical floors gave 30 vs 29.
+bool ambiguous(const MatchResult& r, const MatchParams& params) {
+  constexpr double kClearAhead = 1.25;  ///< the runner-up must have less than 1 / this of the support
+  return r.runner_up_support > 0 && (r.support - r.runner_up_support < params.min_support ||
+                                     static_cast<double>(r.support) < kClearAhead * r.runner_up_support);
 }
 
 /// p_target = R_target^-1 T R_source p_source, with R a map's levelling rotation.
@@ -58,8 +56,8 @@ void judge(MatchResult& r, const MatchParams& params) {
   if (r.support < params.min_support)
     r.reason =
         "only " + std::to_string(r.support) + " slice pairs agree (need " + std::to_string(params.min_support) + ")";
-  else if (ambiguous(r))
-    r.reason = "ambiguous: a height offset " + std::to_string(std::abs(r.runner_up_offset - r.height_offset)) +
+  else if (ambiguous(r, params))
+    r.reason = "ambiguous: another answer " + std::to_string(std::abs(r.runner_up_offset - r.height_offset)) +
                " slices away has almost as much support (" + std::to_string(r.support) + " vs " +
                std::to_string(r.runner_up_support) + " slice pairs)";
   else if (r.inliers < static_cast<size_t>(params.min_inliers))
@@ -138,7 +136,7 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
 
   t0 = Clock::now();
   const std::vector<OffsetScore> scores = scoreOffsets(pairs, target, source, params);
-  const OffsetChoice choice = pickOffset(scores);
+  const OffsetChoice choice = pickOffset(scores, params, source.centre());
   r.timings.consensus = secondsSince(t0);
   if (!choice.best) {
     r.reason = "no slice pair produced an estimate";

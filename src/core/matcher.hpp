@@ -42,7 +42,7 @@ struct MatchResult {
   Eigen::Matrix4d matrix() const { return T_target_source_unleveled.value_or(T_target_source.matrix()); }
 
   int support = 0;                                          ///< agreeing slice pairs at the winning height offset
-  int runner_up_support = 0;                                ///< best support more than one step away from the winner
+  int runner_up_support = 0;                                ///< best support of another answer (OffsetChoice)
   int runner_up_offset = 0;                                 ///< its height offset [slices]
   int height_offset = 0;                                    ///< winning target slice index - source slice index
   std::vector<SupportingPair> supporters;                   ///< the slice pairs behind `support`, most inliers first
