@@ -124,7 +124,11 @@ class Agent {
   std::condition_variable queue_cv_;
   std::deque<std::function<void()>> queue_;
 
-  std::shared_ptr<const MapFeatures> own_features_;
+  std::shared_ptr<const MapFeatures> own_features_;  ///< null until the map file first exists and is usable
+  /// Whether this agent offers a map yet (at boot the file may not exist).
+  bool offering() const { return own_features_ != nullptr; }
+  /// What the status says while nothing is offered.
+  std::string waitingText() const;
   MapSender sender_;
   PeerMaps peers_;
   PairBoard board_;

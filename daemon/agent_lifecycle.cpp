@@ -41,7 +41,11 @@ bool createOutputDir(const std::string& dir, Log& log) {
 
 void Agent::joinNetwork() {
   bus_ = std::make_unique<transport::Bus>(config_.transport, handlers_);
-  bus_->publish(sender_.offer().announcement);
+  if (offering()) bus_->publish(sender_.offer().announcement);
+}
+
+std::string Agent::waitingText() const {
+  return "waiting for map " + config_.map + (map_refused_.empty() ? "" : " (its content: " + map_refused_ + ")");
 }
 
 void Agent::followMapFile() {
@@ -58,8 +62,8 @@ void Agent::followMapFile() {
     } catch (const std::exception& e) {
       // Typically a file caught half-written: its next write brings us back.
       map_refused_ = e.what();
-      log_.warning(std::string("map file changed but cannot be used (") + e.what() + "); still offering version " +
-                   versionText(sender_.version()));
+      log_.warning(std::string("map file changed but cannot be used (") + e.what() + "); " +
+                   (offering() ? "still offering version " + versionText(sender_.version()) : "offering no map yet"));
     }
     return;
   }
@@ -132,7 +136,8 @@ void Agent::tick(Clock::time_point& last_announce) {
   // Repairs a lost or missed announcement. After a peer appeared, once, a
   // little later: peers that appear together get one announcement, since each
   // reaches every receiver.
-  if (now - last_announce > kReannounce || (reannounce_ && now - last_announce > kReannounceAfterPeer)) {
+  if (offering() &&
+      (now - last_announce > kReannounce || (reannounce_ && now - last_announce > kReannounceAfterPeer))) {
     reannounce_ = false;
     bus_->publish(sender_.offer().announcement);
     last_announce = now;
@@ -147,11 +152,18 @@ void Agent::tick(Clock::time_point& last_announce) {
 int Agent::run(Signals& signals) {
   log_.info(describe(config_));
   if (!createOutputDir(config_.output_dir, log_)) return 2;
-  try {
-    installOwnMap(describeOwnMap(config_));
-  } catch (const InputError& e) {
-    log_.error(e.what());
-    return 2;
+  // At boot the map may not be written yet: the agent joins and waits for it
+  // (the folder is watched below). A map that exists but cannot be used is a
+  // mistake to fix, not to wait out.
+  if (fs::exists(config_.map)) {
+    try {
+      installOwnMap(describeOwnMap(config_));
+    } catch (const InputError& e) {
+      log_.error(e.what());
+      return 2;
+    }
+  } else {
+    log_.warning(config_.map + " does not exist yet: waiting for it (matching starts when it appears)");
   }
   auto& h = handlers_;
   h.announcement = [this](wire::MapAnnouncement&& a) {
@@ -183,9 +195,11 @@ int Agent::run(Signals& signals) {
   if (!watch_->active())
     log_.warning("cannot watch the folder of " + config_.map + " for changes: send SIGHUP after updating the map");
   // The log line first: whoever acts on READY=1 (a test, an operator) finds it.
-  log_.info("ready: announced version " + versionText(sender_.version()) + " to " +
-            std::to_string(config_.transport.peers.size()) + " peers");
+  const std::string peers = std::to_string(config_.transport.peers.size()) + " peers";
+  log_.info(offering() ? "ready: announced version " + versionText(sender_.version()) + " to " + peers
+                       : "ready: joined " + peers + "; " + waitingText());
   notifier_.ready();
+  notifier_.status(statusLine());  // says what a waiting agent waits for
 
   auto last_announce = Clock::now();
   while (!signals.stop) {

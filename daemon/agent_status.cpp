@@ -48,8 +48,9 @@ void Agent::persist(bool transforms_changed) {
           {"version", versionText(a.version())},
           {"updated_at_ms", map_updated_ms_},
           {"updating", describing_.valid()},
-          {"tilt_deg",
-           own_features_->tilt.measured ? nlohmann::json(degrees(own_features_->tilt.angle)) : nlohmann::json()},
+          {"waiting", !offering()},
+          {"tilt_deg", offering() && own_features_->tilt.measured ? nlohmann::json(degrees(own_features_->tilt.angle))
+                                                                  : nlohmann::json()},
           {"update_refused", map_refused_},
           {"slices", a.slices().size()},
           {"payload_bytes", offer.payload_bytes},
@@ -77,11 +78,11 @@ std::string Agent::statusLine() const {
   const PeerMaps::Totals in = peers_.totals();
   // Pairs among this agent and its peers, and how many of them are current.
   const size_t pairs = (peers + 1) * peers / 2;
-  std::string line = std::to_string(peers_.aliveCount()) + "/" + std::to_string(peers) + " peers up; " +
-                     std::to_string(in.maps) + "/" + std::to_string(peers) + " peer maps (" +
-                     std::to_string(in.slices_done) + "/" + std::to_string(in.slices_all) + " slices); " +
-                     std::to_string(board_.currentResults()) + "/" + std::to_string(pairs) + " pairs agreed; " +
-                     std::to_string(sender_.bytesSent() / 1000) + " kB sent";
+  std::string line = offering() ? "" : waitingText() + "; ";
+  line += std::to_string(peers_.aliveCount()) + "/" + std::to_string(peers) + " peers up; " + std::to_string(in.maps) +
+          "/" + std::to_string(peers) + " peer maps (" + std::to_string(in.slices_done) + "/" +
+          std::to_string(in.slices_all) + " slices); " + std::to_string(board_.currentResults()) + "/" +
+          std::to_string(pairs) + " pairs agreed; " + std::to_string(sender_.bytesSent() / 1000) + " kB sent";
   if (const auto& c = board_.computing()) line += "; computing " + pairText(c->pair);
   if (describing_.valid()) line += "; describing an updated map";
   return line;

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <thread>
 
@@ -45,6 +46,9 @@ int main(int argc, char** argv) {
   log.setThreshold(config.log_level);
   if (check) {
     std::cout << describe(config) << "\n";
+    // Not an error: at boot the map may come later, and the daemon waits for it.
+    if (!std::filesystem::exists(config.map))
+      log.warning(config.map + " does not exist yet: tomomapd will wait for it");
     return 0;
   }
 

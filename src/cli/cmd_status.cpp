@@ -75,11 +75,15 @@ void printHuman(const json& status, const json& transforms, bool running) {
                         : "NOT RUNNING")
             << "; status written " << ago(status.value("written_at_ms", 0.0)) << "\n";
   std::cout << "  config   " << status.value("config", "?") << "\n";
-  std::cout << "  map      " << map.value("path", "?") << "\n           version " << map.value("version", "?") << ", "
-            << map.value("slices", 0) << " slices, payload " << kB(map.value("payload_bytes", 0.0)) << " ("
-            << fixed(100.0 * map.value("payload_bytes", 0.0) / std::max(1.0, map.value("raw_bytes", 1.0)), 1)
-            << " % of the map's binary PCD)" << (map.value("updating", false) ? ", an update is being described" : "")
-            << "\n";
+  if (map.value("waiting", false))
+    std::cout << "  map      " << map.value("path", "?")
+              << "\n           WAITING: no usable map file yet, nothing offered\n";
+  else
+    std::cout << "  map      " << map.value("path", "?") << "\n           version " << map.value("version", "?") << ", "
+              << map.value("slices", 0) << " slices, payload " << kB(map.value("payload_bytes", 0.0)) << " ("
+              << fixed(100.0 * map.value("payload_bytes", 0.0) / std::max(1.0, map.value("raw_bytes", 1.0)), 1)
+              << " % of the map's binary PCD)" << (map.value("updating", false) ? ", an update is being described" : "")
+              << "\n";
   if (map.contains("tilt_deg") && map["tilt_deg"].is_number())
     std::cout << "           tilt " << fixed(map["tilt_deg"].get<double>(), 1) << " deg\n";
   if (!map.value("update_refused", std::string()).empty())

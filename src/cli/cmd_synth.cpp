@@ -47,8 +47,9 @@ Command addSynthCommand(CLI::App& app) {
   CLI::App* sub =
       app.add_subcommand("synth", "Generate overlapping maps of a procedural world with ground-truth poses.");
   sub->add_option("-o,--out", o->out, "output directory (map_N.pcd, map_N-gtpose.txt, scene.json)")->required();
-  sub->add_option("-w,--world", o->world,
-                  "world type: indoor (2-floor building), outdoor (street) or room (one room, two halves)")
+  sub->add_option(
+         "-w,--world", o->world,
+         "world type: indoor (2-floor building), outdoor (street) or room (one room, both sides of a partition)")
       ->capture_default_str()
       ->check(CLI::IsMember({"indoor", "outdoor", "room"}));
   sub->add_option("-s,--seed", o->seed, "random seed: same seed, same maps")->capture_default_str();

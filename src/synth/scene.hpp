@@ -41,9 +41,9 @@ struct SceneParams {
 
 /// Indoor: a two-floor building, corridor with rooms on both sides, doors,
 /// furniture. Outdoor: a street with facades of varied heights, trees, poles,
-/// parked cars and uneven ground. Room: one furnished room split by a
-/// partition with an opening, each map scanned from one side (partial
-/// overlap, under 30 slices at g = 0.1). Deterministic from the seed.
+/// parked cars and uneven ground. Room: one furnished room with a
+/// partition across half its depth, each map scanned from one side (partial
+/// overlap, under 32 slices at g = 0.1). Deterministic from the seed.
 Scene makeScene(const SceneParams& params);
 
 }  // namespace tomomap::synth

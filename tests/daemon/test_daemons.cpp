@@ -190,7 +190,7 @@ TEST(Daemons, APeerMapOverTheMemoryBudgetIsRefusedAndTheDaemonStaysResponsive) {
   stopAll(fleet, {"alpha", "bravo"});
 }
 
-TEST(Daemons, BadConfigNamesFileLineAndKey) {
+TEST(Daemons, ABadConfigOrABrokenMapExitsSayingWhereAMissingMapDoesNot) {
   TempDir dir;
   std::ofstream(dir / "bad.toml") << "agent = \"alpha\"\nmap = \"x.pcd\"\ndiscovery_port = \"many\"\n";
   const auto r = runBinary(TOMOMAPD_BIN, "--config " + (dir / "bad.toml"));
@@ -198,9 +198,18 @@ TEST(Daemons, BadConfigNamesFileLineAndKey) {
   EXPECT_NE(r.output.find("bad.toml:3:"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("discovery_port"), std::string::npos) << r.output;
 
-  std::ofstream(dir / "missing.toml") << "agent = \"alpha\"\nmap = \"/nonexistent.pcd\"\ndiscovery_port = 24000\n"
-                                      << "output_dir = \"" << (dir / "out") << "\"\n";
-  const auto m = runBinary(TOMOMAPD_BIN, "--config " + (dir / "missing.toml"));
+  // A map that is there but unusable is a mistake to fix: exit 2, saying why.
+  std::ofstream(dir / "broken.pcd") << "# .PCD v0.7\nFIELDS x y\n";
+  std::ofstream(dir / "broken.toml") << "agent = \"alpha\"\nmap = \"" << (dir / "broken.pcd")
+                                     << "\"\ndiscovery_port = 24000\noutput_dir = \"" << (dir / "out") << "\"\n";
+  const auto m = runBinary(TOMOMAPD_BIN, "--config " + (dir / "broken.toml"));
   EXPECT_EQ(m.exit_code, 2);
-  EXPECT_NE(m.output.find("no such file"), std::string::npos) << m.output;
+  EXPECT_NE(m.output.find("broken.pcd"), std::string::npos) << m.output;
+
+  // A map not written yet is not: --check passes and warns (the daemon waits
+  // for it: Operations.ADaemonBootedBeforeItsMapWaitsForItThenMatches).
+  std::ofstream(dir / "later.toml") << "agent = \"alpha\"\nmap = \"/nonexistent.pcd\"\ndiscovery_port = 24000\n";
+  const auto c = runBinary(TOMOMAPD_BIN, "--check --config " + (dir / "later.toml"));
+  EXPECT_EQ(c.exit_code, 0) << c.output;
+  EXPECT_NE(c.output.find("/nonexistent.pcd does not exist yet"), std::string::npos) << c.output;
 }

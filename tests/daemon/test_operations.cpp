@@ -200,6 +200,41 @@ TEST(Operations, NotifiesSystemdReloadsOnSighupAndStopsCleanly) {
   EXPECT_NE(after.output.find("NOT RUNNING"), std::string::npos) << after.output;
 }
 
+TEST(Operations, ADaemonBootedBeforeItsMapWaitsForItThenMatches) {
+  // At boot the SLAM system may not have written the map yet: the service
+  // must come up, say what it waits for, and match once the file appears.
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  const std::string d = demoRoom() + "/";
+  const std::string bravo_map = dir / "bravo.pcd";
+  NotifySocket notify(dir / "notify.sock");
+  Fleet fleet(dir);
+  const std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd"}, {"bravo", bravo_map}};
+  fleet.start(agents[1], agents, {notify.env()});
+  fleet.start(agents[0], agents);
+
+  ASSERT_TRUE(notify.waitFor("READY=1", 30s)) << notify.all() << fleet.log("bravo");
+  EXPECT_NE(notify.all().find("STATUS=waiting for map " + bravo_map), std::string::npos) << notify.all();
+  EXPECT_NE(fleet.log("bravo").find("ready: joined 1 peers; waiting for map " + bravo_map), std::string::npos)
+      << fleet.log("bravo");
+  EXPECT_TRUE(fleet.readJson("bravo", "status.json")["map"]["waiting"].get<bool>());
+  const auto human = runTomomap("status " + (dir / "out-bravo"));
+  EXPECT_NE(human.output.find("WAITING"), std::string::npos) << human.output;
+  // Nothing to match yet: bravo offers no map, and nobody stores a transform.
+  EXPECT_FALSE(fleet.waitExit("bravo", 1000ms).has_value()) << "waits, does not exit";
+  EXPECT_TRUE(fleet.transforms("alpha").empty());
+
+  replaceMap(bravo_map, loadMap(d + "demo-pcd2.pcd"));
+  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 90s)) << fleet.log("alpha") << fleet.log("bravo");
+  const auto t = fleet.transforms("bravo").at("alpha<-bravo");
+  EXPECT_TRUE(t["reliable"].get<bool>()) << t.dump(2);
+  const Pose4 gt =
+      Pose4::fromMatrix(loadPoseFile(d + "demo-pcd1-gtpose.txt") * loadPoseFile(d + "demo-pcd2-gtpose.txt").inverse());
+  EXPECT_LT(poseError(poseOf(t), gt).translation, 0.05);
+  EXPECT_FALSE(fleet.readJson("bravo", "status.json")["map"]["waiting"].get<bool>());
+  stopAll(fleet, {"alpha", "bravo"});
+}
+
 TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
   REQUIRE_DEMO_ROOM();
   TempDir dir;
