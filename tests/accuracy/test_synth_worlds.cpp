@@ -59,3 +59,28 @@ INSTANTIATE_TEST_SUITE_P(LargeWorlds, SynthAccuracy,
                          ::testing::Values(WorldCase{WorldType::Indoor, "low"}, WorldCase{WorldType::Indoor, "high"},
                                            WorldCase{WorldType::Outdoor, "low"}, WorldCase{WorldType::Outdoor, "high"}),
                          caseName);
+
+// Small rooms (under 32 slices at g 0.1, partial overlap) are not solved yet
+// (docs/results.md, "Small rooms"): what must hold meanwhile is that the
+// matcher says so instead of passing off a wrong transform as reliable.
+TEST(SmallRooms, AreRefusedRatherThanAnsweredWrong) {
+  for (const double grid : {0.1, 0.05}) {
+    int right = 0, refused = 0, wrong = 0;
+    for (uint64_t seed = 1; seed <= 10; ++seed) {
+      SceneParams sp;
+      sp.type = WorldType::Room;
+      sp.seed = seed;
+      const auto maps = scanScene(makeScene(sp), noiseLevel("low"), seed);
+      MatchParams mp;
+      mp.grid = grid;
+      const MatchResult r = matchMaps(maps[0].points, maps[1].points, mp);
+      const PoseError e = poseError(r.T_target_source, Pose4::fromMatrix(maps[0].pose * maps[1].pose.inverse()));
+      const bool ok = e.translation < 5 * grid && e.yaw < radians(10);
+      (r.reliable ? (ok ? right : wrong) : refused)++;
+      std::cout << "room seed " << seed << " g " << grid << ": "
+                << (r.reliable ? (ok ? "right" : "WRONG") : "no reliable match: " + r.reason) << "\n";
+    }
+    std::cout << "g " << grid << ": " << right << " right, " << refused << " refused, " << wrong << " wrong\n";
+    EXPECT_EQ(wrong, 0) << "at g " << grid;
+  }
+}
