@@ -22,7 +22,9 @@
 #include "pair_board.hpp"
 #include "peer_maps.hpp"
 #include "rejection_log.hpp"
+#include "results/tf_tree.hpp"
 #include "transport/bus.hpp"
+#include "transport/tf_static.hpp"
 
 namespace tomomap::daemon {
 
@@ -105,14 +107,21 @@ class Agent {
   void logIfKept(const PairKey& pair);
   std::shared_ptr<const MapFeatures> featuresOf(const std::string& agent) const;
 
-  // ---- what it tells its operator (agent_status.cpp)
+  // ---- what it tells its operator (agent_status.cpp) and ROS 2 (agent_ros2.cpp)
   void persist(bool transforms_changed);
+  /// Creates the /tf_static publisher when [ros2] asks for it (a failure is
+  /// logged: the fleet works on without it).
+  void startRos2();
+  /// Publishes the agreed transforms' tree on /tf_static if it changed.
+  void publishTree();
   /// One line of progress for systemd's STATUS= (and `systemctl status`).
   std::string statusLine() const;
 
   Config config_;
   Log& log_;
   std::unique_ptr<transport::Bus> bus_;
+  std::unique_ptr<transport::TfStaticPublisher> tf_;
+  std::optional<std::vector<TreeEdge>> tf_published_;  ///< what /tf_static holds; none before the first sample
   transport::BusHandlers handlers_;
   Notifier notifier_;
   std::unique_ptr<MapWatch> watch_;

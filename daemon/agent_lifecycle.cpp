@@ -117,6 +117,7 @@ void Agent::reload() {
       joinNetwork();  // worked before; if not, the error ends the process and systemd restarts it
     }
   }
+  if (!(previous.ros2 == config_.ros2) || previous.treeRoot() != config_.treeRoot()) startRos2();
   watch_ = std::make_unique<MapWatch>(config_.map);
   map_touched_ = Clock::now() - kMapSettle;  // and read the map again now
   persist(true);
@@ -190,6 +191,7 @@ int Agent::run(Signals& signals) {
     log_.error(e.what());
     return 2;
   }
+  startRos2();
   persist(true);
   watch_ = std::make_unique<MapWatch>(config_.map);
   if (!watch_->active())

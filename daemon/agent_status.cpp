@@ -18,6 +18,7 @@ void Agent::persist(bool transforms_changed) {
       nlohmann::json list = nlohmann::json::array();
       for (const auto& [key, t] : board_.results()) list.push_back(toJson(t));
       writeJsonAtomically((dir / "transforms.json").string(), {{"agent", config_.agent()}, {"transforms", list}});
+      publishTree();  // the other way results leave the daemon
     }
     nlohmann::json peers = nlohmann::json::object();
     for (const auto& peer : config_.transport.peers) {

@@ -52,7 +52,12 @@ const std::vector<std::string> kKeys{"agent",
                                      "security.private_key",
                                      "security.governance",
                                      "security.permissions",
-                                     "security.crl"};
+                                     "security.crl",
+                                     "ros2.enabled",
+                                     "ros2.domain",
+                                     "ros2.frame",
+                                     "ros2.root",
+                                     "ros2.localhost_only"};
 
 struct Reader {
   std::string file;
@@ -95,6 +100,13 @@ struct Reader {
     const auto v = n->value<double>();
     if (!v || !(*v >= lo && *v <= hi)) fail(*n, key, "must be a number from " + toString(lo) + " to " + toString(hi));
     return *v;
+  }
+
+  bool flag(const toml::table& t, const std::string& key, bool fallback) const {
+    const toml::node* n = t.get(key);
+    if (!n) return fallback;
+    if (!n->is_boolean()) fail(*n, key, "must be true or false");
+    return n->value<bool>().value();
   }
 
   static std::string toString(double v) {
@@ -142,6 +154,22 @@ void readMatch(const Reader& r, const toml::table& root, MatchParams& m) {
   m.max_tilt = radians(r.number(*t, "max_tilt_deg", degrees(m.max_tilt), 0, 90));
 }
 
+/// The [ros2] table: present means on, unless it says `enabled = false`.
+void readRos2(const Reader& r, const toml::table& root, Config& c) {
+  const toml::table* t = knownTable(r, root, "ros2");
+  if (!t) return;
+  Ros2Config& ros = c.ros2;
+  ros.enabled = r.flag(*t, "enabled", true);
+  ros.domain = r.integer(*t, "domain", ros.domain, 0, 232);
+  ros.frame = r.text(*t, "frame", ros.frame);
+  if (ros.frame.find("{agent}") == std::string::npos)
+    r.fail(*t->get("frame"), "ros2.frame", "must contain {agent} (each map needs its own frame)");
+  ros.root = r.text(*t, "root", std::string());
+  if (!ros.root.empty() && ros.root != c.agent() && !c.isPeer(ros.root))
+    r.fail(*t->get("root"), "ros2.root", "'" + ros.root + "' is neither this agent nor one of its peers");
+  ros.localhost_only = r.flag(*t, "localhost_only", ros.localhost_only);
+}
+
 /// The [security] table: DDS Security's files, each of which must exist
 /// (relative paths from the config's folder). All but `crl` are required.
 void readSecurity(const Reader& r, const toml::table& root,
@@ -185,6 +213,20 @@ bool Config::isPeer(const std::string& id) const {
   return false;
 }
 
+std::string Config::treeRoot() const {
+  if (!ros2.root.empty()) return ros2.root;
+  std::string lowest = agent();
+  for (const auto& p : transport.peers) lowest = std::min(lowest, p.id);
+  return lowest;
+}
+
+std::string Ros2Config::frameOf(const std::string& agent) const {
+  std::string f = frame;
+  for (size_t at = f.find("{agent}"); at != std::string::npos; at = f.find("{agent}", at + agent.size()))
+    f.replace(at, 7, agent);
+  return f;
+}
+
 const std::vector<std::string>& configKeys() { return kKeys; }
 
 Config loadConfig(const std::string& path) {
@@ -202,7 +244,8 @@ Config loadConfig(const std::string& path) {
   auto resolve = [&](const std::string& p) { return (base / p).lexically_normal().string(); };
   for (const auto& [key, node] : root) {
     const std::string k(key.str());
-    if (k != "peer" && k != "match" && k != "security" && std::find(kKeys.begin(), kKeys.end(), k) == kKeys.end())
+    if (k != "peer" && k != "match" && k != "security" && k != "ros2" &&
+        std::find(kKeys.begin(), kKeys.end(), k) == kKeys.end())
       r.fail(node, k, "unknown key (see docs/configuration.md)");
   }
 
@@ -259,6 +302,7 @@ Config loadConfig(const std::string& path) {
       t.peers.push_back(pa);
     }
   }
+  readRos2(r, root, c);  // after the peers: its root must be one of the fleet
   return c;
 }
 
@@ -289,6 +333,12 @@ std::string describe(const Config& c) {
       << "\n  security.permissions = " << f.permissions << "\n  security.crl = " << f.crl;
   else
     o << "\n  security: off (no [security] table)";
+  if (c.ros2.enabled)
+    o << "\n  ros2.domain = " << c.ros2.domain << "\n  ros2.frame = " << c.ros2.frame
+      << "\n  ros2.root = " << c.treeRoot()
+      << "\n  ros2.localhost_only = " << (c.ros2.localhost_only ? "true" : "false");
+  else
+    o << "\n  ros2: off (no [ros2] table)";
   for (const auto& p : t.peers) o << "\n  peer " << p.id << " = " << p.host << ":" << p.port;
   return o.str();
 }

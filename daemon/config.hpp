@@ -10,6 +10,21 @@ namespace tomomap::daemon {
 
 enum class LogLevel { Debug, Info, Warning, Error };
 
+/// The [ros2] table: the fleet's frames on ROS 2's /tf_static (docs/configuration.md).
+struct Ros2Config {
+  bool enabled = false;               ///< on when the table is present, unless `enabled = false`
+  int domain = 0;                     ///< the ROS 2 nodes' ROS_DOMAIN_ID
+  std::string frame = "{agent}/map";  ///< frame id of each agent's map; {agent} is replaced by its id
+  std::string root;                   ///< the tree's root agent; empty: the lowest id in the fleet
+  bool localhost_only = true;         ///< reach ROS 2 nodes on this robot only, never the robots' link
+
+  std::string frameOf(const std::string& agent) const;
+  bool operator==(const Ros2Config& o) const {
+    return enabled == o.enabled && domain == o.domain && frame == o.frame && root == o.root &&
+           localhost_only == o.localhost_only;
+  }
+};
+
 struct Config {
   std::string file;                      ///< where it was read from
   transport::TransportConfig transport;  ///< agent id, domain, address, ports, peers, bandwidth
@@ -20,9 +35,12 @@ struct Config {
   double claim_timeout_s = 30;    ///< a claim without a result is void after this [s]
   double request_interval_s = 1;  ///< ask again for missing slices after this much silence [s]
   double peer_memory_mb = 256;    ///< memory one peer's map may take here, checked before it is allocated [MB]
+  Ros2Config ros2;
 
   const std::string& agent() const { return transport.agent; }
   bool isPeer(const std::string& id) const;
+  /// The root of the frame tree: [ros2] root, or the lowest id in the fleet.
+  std::string treeRoot() const;
 };
 
 /// peer_memory_mb in bytes.

@@ -169,6 +169,12 @@ class Fleet {
   std::map<std::string, pid_t> pids_;
 };
 
+/// T_target_source of one transforms.json entry.
+inline Pose4 poseOf(const nlohmann::json& t) {
+  const auto& T = t["T_target_source"];
+  return {T["x"].get<double>(), T["y"].get<double>(), T["z"].get<double>(), T["yaw"].get<double>()};
+}
+
 /// Stops every agent with SIGTERM and checks each leaves within 2 s, cleanly.
 inline void stopAll(Fleet& fleet, const std::vector<std::string>& ids) {
   using namespace std::chrono_literals;

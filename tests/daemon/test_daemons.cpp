@@ -10,11 +10,6 @@ using namespace std::chrono_literals;
 
 namespace {
 
-Pose4 poseOf(const nlohmann::json& t) {
-  const auto& T = t["T_target_source"];
-  return {T["x"].get<double>(), T["y"].get<double>(), T["z"].get<double>(), T["yaw"].get<double>()};
-}
-
 /// Ground truth T_target_source for maps written by `tomomap synth` or demo-room.
 Pose4 truth(const std::string& target_pose, const std::string& source_pose) {
   return Pose4::fromMatrix(loadPoseFile(target_pose) * loadPoseFile(source_pose).inverse());

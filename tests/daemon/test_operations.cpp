@@ -127,11 +127,6 @@ std::vector<AgentSpec> startDemoPairWithBravosMapInDir(Fleet& fleet, const TempD
   return agents;
 }
 
-Pose4 poseOf(const nlohmann::json& t) {
-  const auto& T = t["T_target_source"];
-  return {T["x"].get<double>(), T["y"].get<double>(), T["z"].get<double>(), T["yaw"].get<double>()};
-}
-
 }  // namespace
 
 TEST(Operations, NotifiesSystemdReloadsOnSighupAndStopsCleanly) {

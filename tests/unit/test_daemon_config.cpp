@@ -91,12 +91,37 @@ TEST(DaemonConfig, TheMatchTableOverridesTheMatchersDefaults) {
   EXPECT_NE(e.find("must be a table"), std::string::npos) << e;
 }
 
+TEST(DaemonConfig, TheRos2TableTurnsTfStaticOnWithFramesAndARootFromTheFleet) {
+  TempDir dir;
+  const std::string base = "agent = \"bravo\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n";
+  const std::string peers = "[[peer]]\nid = \"alpha\"\nhost = \"1.2.3.4\"\nport = 17600\n";
+  std::ofstream(dir / "c.toml") << base << peers;
+  const Config off = loadConfig(dir / "c.toml");
+  EXPECT_FALSE(off.ros2.enabled) << "no table, no ROS 2";
+  std::ofstream(dir / "c.toml") << base << peers << "[ros2]\ndomain = 7\n";
+  const Config on = loadConfig(dir / "c.toml");
+  EXPECT_TRUE(on.ros2.enabled);
+  EXPECT_EQ(on.ros2.domain, 7);
+  EXPECT_TRUE(on.ros2.localhost_only);
+  EXPECT_EQ(on.treeRoot(), "alpha") << "the lowest id of the fleet";
+  EXPECT_EQ(on.ros2.frameOf("bravo"), "bravo/map");
+  EXPECT_NE(describe(on).find("ros2.root = alpha"), std::string::npos) << describe(on);
+
+  std::string e = errorOf(dir, base + peers + "[ros2]\nroot = \"zulu\"\n");
+  EXPECT_NE(e.find("'ros2.root': 'zulu' is neither this agent nor one of its peers"), std::string::npos) << e;
+  e = errorOf(dir, base + peers + "[ros2]\nframe = \"map\"\n");
+  EXPECT_NE(e.find("c.toml:9:"), std::string::npos) << e;
+  EXPECT_NE(e.find("must contain {agent}"), std::string::npos) << e;
+  e = errorOf(dir, base + "[ros2]\nenabled = \"yes\"\n");
+  EXPECT_NE(e.find("'enabled': must be true or false"), std::string::npos) << e;
+}
+
 TEST(DaemonConfig, EveryKeyIsInTheReference) {
   std::ifstream in(std::string(TOMOMAP_SOURCE_DIR) + "/docs/configuration.md");
   const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_FALSE(doc.empty());
   for (std::string key : configKeys()) {
-    for (const std::string table : {"peer.", "match.", "security."})
+    for (const std::string table : {"peer.", "match.", "security.", "ros2."})
       if (key.rfind(table, 0) == 0) key = key.substr(table.size());
     EXPECT_NE(doc.find("`" + key + "`"), std::string::npos) << key << " is not in docs/configuration.md";
   }
@@ -106,7 +131,7 @@ TEST(DaemonConfig, EveryKeyInTheReferenceIsOneTheDaemonReads) {
   std::ifstream in(std::string(TOMOMAP_SOURCE_DIR) + "/docs/configuration.md");
   std::string line;
   size_t rows = 0;
-  const std::regex row(R"(^\| (`\[\[peer\]\]` |`\[match\]` |`\[security\]` )?`([a-z_]+)` \|)");
+  const std::regex row(R"(^\| (`\[\[peer\]\]` |`\[match\]` |`\[security\]` |`\[ros2\]` )?`([a-z_]+)` \|)");
   while (std::getline(in, line)) {
     std::smatch m;
     if (!std::regex_search(line, m, row)) continue;
@@ -115,6 +140,7 @@ TEST(DaemonConfig, EveryKeyInTheReferenceIsOneTheDaemonReads) {
     const std::string table = !m[1].matched                                  ? ""
                               : prefix.find("peer") != std::string::npos     ? "peer."
                               : prefix.find("security") != std::string::npos ? "security."
+                              : prefix.find("ros2") != std::string::npos     ? "ros2."
                                                                              : "match.";
     const std::string key = table + m[2].str();
     const auto& keys = configKeys();

@@ -1,0 +1,52 @@
+// The fleet's frames on ROS 2's /tf_static: the agreed transforms' spanning
+// tree (results/tf_tree.hpp), republished whole whenever it changes.
+#include "agent.hpp"
+
+namespace tomomap::daemon {
+
+namespace {
+
+bool sameTree(const std::vector<TreeEdge>& a, const std::vector<TreeEdge>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const Pose4 &p = a[i].T_parent_child, &q = b[i].T_parent_child;
+    if (a[i].parent != b[i].parent || a[i].child != b[i].child || a[i].stamp_ms != b[i].stamp_ms || p.x != q.x ||
+        p.y != q.y || p.z != q.z || p.yaw != q.yaw)
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void Agent::startRos2() {
+  tf_.reset();
+  tf_published_.reset();
+  if (!config_.ros2.enabled) return;
+  try {
+    tf_ = std::make_unique<transport::TfStaticPublisher>(config_.ros2.domain, config_.ros2.localhost_only);
+    log_.info("ROS 2: publishing the fleet's frames on /tf_static (domain " + std::to_string(config_.ros2.domain) +
+              ", root frame " + config_.ros2.frameOf(config_.treeRoot()) + ")");
+  } catch (const std::exception& e) {
+    log_.error(std::string("ROS 2: cannot publish /tf_static (") + e.what() + "); transforms.json is still written");
+  }
+}
+
+void Agent::publishTree() {
+  if (!tf_) return;
+  std::vector<AgreedTransform> agreed;
+  for (const auto& [key, t] : board_.results()) agreed.push_back(t);
+  std::vector<TreeEdge> tree = spanningTree(agreed, config_.treeRoot());
+  // An empty tree is published too, once: a late reader then gets a sample.
+  if (tf_published_ && sameTree(tree, *tf_published_)) return;
+  std::vector<transport::TfFrame> frames;
+  for (const auto& e : tree)
+    frames.push_back({config_.ros2.frameOf(e.parent), config_.ros2.frameOf(e.child), e.T_parent_child, e.stamp_ms});
+  tf_->publish(frames);
+  log_.info("ROS 2: /tf_static holds " + std::to_string(frames.size()) + " of the fleet's " +
+            std::to_string(config_.transport.peers.size()) + " other frames under " +
+            config_.ros2.frameOf(config_.treeRoot()));
+  tf_published_ = std::move(tree);
+}
+
+}  // namespace tomomap::daemon

@@ -1,0 +1,24 @@
+#pragma once
+// The fleet's maps as one tree of frames, as ROS 2's tf wants them: every map
+// but the root has exactly one parent, with no cycles, although the fleet
+// agrees a transform for every pair it can.
+#include <string>
+#include <vector>
+
+#include "agreed_transform.hpp"
+
+namespace tomomap {
+
+struct TreeEdge {
+  std::string parent, child;  ///< agent ids
+  Pose4 T_parent_child;       ///< p_parent = T_parent_child * p_child
+  uint64_t stamp_ms = 0;      ///< when the transform behind it was computed [ms since the epoch]
+};
+
+/// The reliable transforms among `agreed` that tie the most maps to `root`,
+/// each map through its best-supported link (a maximum spanning tree by
+/// support, grown from the root; ties go to the lower ids). Maps with no
+/// reliable path to the root are left out. Parents come before children.
+std::vector<TreeEdge> spanningTree(const std::vector<AgreedTransform>& agreed, const std::string& root);
+
+}  // namespace tomomap

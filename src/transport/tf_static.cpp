@@ -1,0 +1,92 @@
+#include "tf_static.hpp"
+
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <stdexcept>
+
+#include "ros2_tfPubSubTypes.h"
+
+namespace tomomap::transport {
+
+using namespace eprosima::fastdds::dds;
+namespace ros_tf = tf2_msgs::msg::dds_;
+namespace ros_geometry = geometry_msgs::msg::dds_;
+
+/// ROS 2's names: topic "rt/" + the ROS topic name.
+constexpr const char* kTfStaticTopic = "rt/tf_static";
+
+Eigen::Vector4d yawQuaternion(double yaw) { return {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)}; }
+
+struct TfStaticPublisher::Impl {
+  DomainParticipant* participant = nullptr;
+  DataWriter* writer = nullptr;
+
+  ~Impl() {
+    if (participant) {
+      participant->delete_contained_entities();
+      DomainParticipantFactory::get_instance()->delete_participant(participant);
+    }
+  }
+};
+
+TfStaticPublisher::TfStaticPublisher(int ros_domain, bool localhost_only) : impl_(std::make_unique<Impl>()) {
+  DomainParticipantQos q;
+  q.name("tomomapd_tf");
+  if (localhost_only) {
+    q.transport().use_builtin_transports = false;
+    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+    udp->interfaceWhiteList.emplace_back("127.0.0.1");
+    q.transport().user_transports.push_back(udp);
+    q.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+  }
+  auto& i = *impl_;
+  i.participant = DomainParticipantFactory::get_instance()->create_participant(ros_domain, q);
+  if (!i.participant)
+    throw std::runtime_error("cannot create the ROS 2 participant on domain " + std::to_string(ros_domain));
+  TypeSupport type(new ros_tf::TFMessage_PubSubType());
+  if (type.register_type(i.participant) != ReturnCode_t::RETCODE_OK)
+    throw std::runtime_error("cannot register " + type.get_type_name());
+  Topic* topic = i.participant->create_topic(kTfStaticTopic, type.get_type_name(), TOPIC_QOS_DEFAULT);
+  Publisher* publisher = i.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
+  if (!topic || !publisher) throw std::runtime_error(std::string("cannot create ") + kTfStaticTopic);
+  // tf2_ros::StaticTransformBroadcaster's QoS: depth 1, reliable, transient local.
+  DataWriterQos wq = DATAWRITER_QOS_DEFAULT;
+  wq.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  wq.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
+  wq.history().kind = KEEP_LAST_HISTORY_QOS;
+  wq.history().depth = 1;
+  wq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+  i.writer = publisher->create_datawriter(topic, wq);
+  if (!i.writer) throw std::runtime_error(std::string("cannot create the writer of ") + kTfStaticTopic);
+}
+
+TfStaticPublisher::~TfStaticPublisher() = default;
+
+void TfStaticPublisher::publish(const std::vector<TfFrame>& frames) {
+  ros_tf::TFMessage_ msg;
+  for (const auto& f : frames) {
+    ros_geometry::TransformStamped_ t;
+    t.header().stamp().sec(static_cast<int32_t>(f.stamp_ms / 1000));
+    t.header().stamp().nanosec(static_cast<uint32_t>(f.stamp_ms % 1000) * 1000000u);
+    t.header().frame_id(f.parent);
+    t.child_frame_id(f.child);
+    t.transform().translation().x(f.T_parent_child.x);
+    t.transform().translation().y(f.T_parent_child.y);
+    t.transform().translation().z(f.T_parent_child.z);
+    const Eigen::Vector4d r = yawQuaternion(f.T_parent_child.yaw);
+    t.transform().rotation().x(r[0]);
+    t.transform().rotation().y(r[1]);
+    t.transform().rotation().z(r[2]);
+    t.transform().rotation().w(r[3]);
+    msg.transforms().push_back(std::move(t));
+  }
+  impl_->writer->write(&msg);
+}
+
+}  // namespace tomomap::transport
