@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "agent.hpp"
+#include "results/json_schema.hpp"
 #include "state_files.hpp"
 
 namespace tomomap::daemon {
@@ -17,7 +18,8 @@ void Agent::persist(bool transforms_changed) {
     if (transforms_changed) {
       nlohmann::json list = nlohmann::json::array();
       for (const auto& [key, t] : board_.results()) list.push_back(toJson(t));
-      writeJsonAtomically((dir / "transforms.json").string(), {{"agent", config_.agent()}, {"transforms", list}});
+      writeJsonAtomically((dir / "transforms.json").string(),
+                          {{"schema_version", kJsonSchemaVersion}, {"agent", config_.agent()}, {"transforms", list}});
       publishTree();  // the other way results leave the daemon
     }
     nlohmann::json peers = nlohmann::json::object();
@@ -39,6 +41,7 @@ void Agent::persist(bool transforms_changed) {
     const auto& a = offer.announcement;
     const auto& computing = board_.computing();
     nlohmann::json status{
+        {"schema_version", kJsonSchemaVersion},
         {"agent", config_.agent()},
         {"pid", ::getpid()},
         {"config", config_.file},

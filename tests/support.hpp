@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -37,6 +38,27 @@ inline size_t countOf(const std::string& text, const std::string& what) {
 }
 
 /// A fresh directory removed when the object goes out of scope.
+/// The top-level fields docs/json.md lists for one document: the rows
+/// "| `field` |" of the table under the heading that contains `section`.
+inline std::set<std::string> documentedJsonFields(const std::string& section) {
+  std::ifstream in(std::string(TOMOMAP_SOURCE_DIR) + "/docs/json.md");
+  std::set<std::string> fields;
+  bool inside = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("## ", 0) == 0) inside = line.find(section) != std::string::npos;
+    if (inside && line.rfind("| `", 0) == 0) fields.insert(line.substr(3, line.find('`', 3) - 3));
+  }
+  return fields;
+}
+
+/// The keys of a JSON object, as text.
+template <typename Json>
+std::set<std::string> keysOf(const Json& object) {
+  std::set<std::string> keys;
+  for (const auto& [key, value] : object.items()) keys.insert(key);
+  return keys;
+}
+
 struct TempDir {
   std::filesystem::path path;
   TempDir() {

@@ -52,6 +52,6 @@ int main(int argc, char** argv) {
     r.timings.features = b.describe_seconds;
     r.timings.pair_matching = b.ransac_seconds;
     return report(r, P_target, P_source, p.grid, {json, /*baseline=*/true, false},
-                  {{"target_points", t.size()}, {"source_points", s.size()}});
+                  {{"target", target}, {"source", source}, {"target_points", t.size()}, {"source_points", s.size()}});
   });
 }

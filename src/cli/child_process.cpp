@@ -1,6 +1,8 @@
 #include "child_process.hpp"
 
 #include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -10,7 +12,7 @@
 
 namespace tomomap::cli {
 
-ChildRun runChild(const std::vector<std::string>& argv) {
+ChildRun runChild(const std::vector<std::string>& argv, double timeout_s) {
   ChildRun r;
   int fds[2];
   if (pipe(fds) != 0) return r;
@@ -33,7 +35,24 @@ ChildRun runChild(const std::vector<std::string>& argv) {
     return r;
   }
   char buf[4096];
-  for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) > 0;) r.output.append(buf, static_cast<size_t>(n));
+  const auto deadline = t0 + std::chrono::duration<double>(timeout_s);
+  for (;;) {
+    int wait_ms = -1;
+    if (timeout_s > 0) {
+      const auto left = std::chrono::duration<double, std::milli>(deadline - std::chrono::steady_clock::now()).count();
+      if (left <= 0) {
+        kill(pid, SIGKILL);
+        r.timed_out = true;
+        break;
+      }
+      wait_ms = static_cast<int>(std::min(left, 1000.0)) + 1;
+    }
+    pollfd p{fds[0], POLLIN, 0};
+    if (poll(&p, 1, wait_ms) == 0) continue;  // nothing yet: look at the clock again
+    const ssize_t n = read(fds[0], buf, sizeof buf);
+    if (n <= 0) break;
+    r.output.append(buf, static_cast<size_t>(n));
+  }
   close(fds[0]);
   int status = 0;
   rusage usage{};

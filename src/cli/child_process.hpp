@@ -11,9 +11,11 @@ struct ChildRun {
   double seconds = 0;      ///< wall time
   double peak_rss_mb = 0;  ///< maximum resident set size
   std::string output;      ///< stdout and stderr together
+  bool timed_out = false;  ///< killed after the time limit
 };
 
-ChildRun runChild(const std::vector<std::string>& argv);
+/// `timeout_s` > 0: the child is killed (SIGKILL) once it has run that long.
+ChildRun runChild(const std::vector<std::string>& argv, double timeout_s = 0);
 
 /// Absolute path of a binary installed beside the running one.
 std::string siblingBinary(const std::string& name);

@@ -15,6 +15,7 @@
 #include "core/stats.hpp"
 #include "exit_codes.hpp"
 #include "io/map_io.hpp"
+#include "results/json_schema.hpp"
 #include "suite.hpp"
 #include "synth_files.hpp"
 #include "transport/wire_sizes.hpp"
@@ -50,7 +51,14 @@ std::string csv(const Row& r) {
   return o.str();
 }
 
-Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratch, int threads) {
+/// 0.5 -> "0.5", 2 -> "2": for names.
+std::string shortNumber(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratch, int threads, double timeout_s) {
   Row row;
   row.pair = p.name;
   row.noise = p.noise;
@@ -67,10 +75,14 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
                         std::string("--gt-target"), p.gt_target, std::string("--gt-source"), p.gt_source,
                         std::string("-j"), std::to_string(threads)})
     argv.push_back(a);
-  const ChildRun run = runChild(argv);
+  const ChildRun run = runChild(argv, timeout_s);
   row.exit_code = run.exit_code;
   row.seconds = run.seconds;
   row.peak_rss_mb = run.peak_rss_mb;
+  if (run.timed_out) {
+    row.note = "timed out after " + shortNumber(timeout_s) + " s";
+    return row;
+  }
   std::ifstream in(json);
   if (run.exit_code > 1 || !in) {
     row.note = run.output.substr(0, run.output.find('\n'));
@@ -92,13 +104,6 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   if (method == "tomomap")
     row.payload_bytes = static_cast<double>(transport::kFeatureBytes) * row.features + kBytesPerSlice * row.slices;
   return row;
-}
-
-/// 0.5 -> "0.5", 2 -> "2": for names.
-std::string shortNumber(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
 }
 
 std::string summary(const std::string& suite, const std::vector<Row>& rows) {
@@ -175,6 +180,7 @@ struct EvalOptions {
   std::string suite, out = "eval-out";
   std::vector<std::string> methods;
   int threads = 0;
+  double timeout_s = 0;  ///< per run; 0 = none
 };
 
 int runEval(const EvalOptions& o) {
@@ -214,11 +220,14 @@ int runEval(const EvalOptions& o) {
   for (const auto& p : suite.pairs) total += methodsOf(p).size();
   for (const auto& p : suite.pairs)
     for (const auto& m : methodsOf(p)) {
-      Row r = runOne(p, m, out, o.threads);
+      // Said before it starts: a baseline run can take minutes.
+      std::cerr << "[" << rows.size() + 1 << "/" << total << "] " << p.name << " " << m << ": running\n";
+      Row r = runOne(p, m, out, o.threads, o.timeout_s);
       rows.push_back(r);
       // Written as they finish: an interrupted run keeps every finished row.
       rows_csv << csv(r) << std::endl;
-      rows_json << nlohmann::json{{"pair", r.pair},
+      rows_json << nlohmann::json{{"schema_version", kJsonSchemaVersion},
+                                  {"pair", r.pair},
                                   {"noise", r.noise},
                                   {"method", r.method},
                                   {"exit_code", r.exit_code},
@@ -241,7 +250,7 @@ int runEval(const EvalOptions& o) {
                 << m
                 << (r.success          ? "success"
                     : r.exit_code == 1 ? "no match"
-                    : r.exit_code > 1  ? "error"
+                    : r.exit_code != 0 ? "error"
                                        : "FAILED")
                 << std::fixed << std::setprecision(3) << "  t " << r.translation_error << " m  yaw " << r.yaw_error
                 << " rad  " << std::setprecision(2) << r.seconds << " s  " << std::setprecision(0) << r.peak_rss_mb
@@ -268,6 +277,10 @@ Command addEvalCommand(CLI::App& app) {
   sub->add_option("-j,--threads", o->threads, "threads per match (0 = all cores)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));
+  sub->add_option("--timeout", o->timeout_s,
+                  "seconds one run may take; then it is killed and its row says so (0 = none)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   return {sub, [o] { return runEval(*o); }};
 }
 

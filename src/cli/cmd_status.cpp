@@ -18,6 +18,7 @@
 #include "core/types.hpp"
 #include "exit_codes.hpp"
 #include "results/agreed_transform.hpp"
+#include "results/json_schema.hpp"
 
 namespace tomomap::cli {
 namespace {
@@ -145,7 +146,11 @@ int runStatus(const StatusOptions& o) {
   const bool fresh = (nowMs() - status.value("written_at_ms", 0.0)) / 1000 < kStaleSeconds;
   const bool running = fresh && processAlive(status.value("pid", 0));
   if (o.json) {
-    std::cout << json{{"running", running}, {"status", status}, {"transforms", transforms["transforms"]}}.dump(2)
+    std::cout << json{{"schema_version", kJsonSchemaVersion},
+                      {"running", running},
+                      {"status", status},
+                      {"transforms", transforms["transforms"]}}
+                     .dump(2)
               << "\n";
   } else {
     printHuman(status, transforms, running);
@@ -169,7 +174,8 @@ Command addStatusCommand(CLI::App& app) {
             try {
               return runStatus(*o);
             } catch (const InputError& e) {
-              std::cout << json{{"running", false}, {"error", e.what()}}.dump(2) << "\n";
+              std::cout << json{{"schema_version", kJsonSchemaVersion}, {"running", false}, {"error", e.what()}}.dump(2)
+                        << "\n";
               throw;
             }
           }};

@@ -24,8 +24,9 @@ MatchedFiles matchFiles(MatchFilesOptions o) {
   auto describe = [&](const std::string& path, const char* role) {
     size_t nonfinite = 0;
     const Points map = loadMap(path, &nonfinite);
-    m.sizes[std::string(role) + "_points"] = map.size();
-    m.sizes[std::string(role) + "_nonfinite_dropped"] = nonfinite;
+    m.inputs[role] = path;
+    m.inputs[std::string(role) + "_points"] = map.size();
+    m.inputs[std::string(role) + "_nonfinite_dropped"] = nonfinite;
     if (nonfinite > 0)
       std::cerr << "warning: " << path << ": dropped " << nonfinite << " points with NaN or infinite coordinates\n";
     if (!o.quiet) std::cout << role << " " << path << " (" << map.size() << " points)\n";
@@ -33,7 +34,7 @@ MatchedFiles matchFiles(MatchFilesOptions o) {
     if (f.leveled)
       std::cerr << "note: " << path << ": levelled: it leaned " << fixed(degrees(f.tilt.angle), 1)
                 << " deg from gravity\n";
-    m.sizes[std::string(role) + "_stray_voxels"] = f.occupancy.stray;
+    m.inputs[std::string(role) + "_stray_voxels"] = f.occupancy.stray;
     if (f.occupancy.stray > 0)
       std::cerr << "warning: " << path << ": left out " << f.occupancy.stray
                 << " stray voxels far from the rest of the map (a gap of " << kStrayGap << " m or more)\n";

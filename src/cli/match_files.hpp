@@ -21,7 +21,7 @@ struct MatchedFiles {
   MapFeatures target, source;
   MatchResult result;
   std::optional<Eigen::Matrix4d> P_target, P_source;  ///< ground truth, when given
-  nlohmann::json sizes;                               ///< target_points, source_points
+  nlohmann::json inputs;  ///< for the JSON: each map's path, points, points dropped, stray voxels
 };
 
 /// Reads the ground truth first (so a bad pose file fails before minutes of

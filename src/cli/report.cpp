@@ -5,6 +5,8 @@
 #include <iostream>
 
 #include "exit_codes.hpp"
+#include "results/json_schema.hpp"
+#include "version.hpp"
 
 namespace tomomap::cli {
 namespace {
@@ -138,7 +140,10 @@ int report(const MatchResult& r, const std::optional<Eigen::Matrix4d>& P_target,
     printResult(text, r, gt, how.baseline);
   if (!how.json.empty()) {
     auto j = toJson(r, gt);
+    j["schema_version"] = kJsonSchemaVersion;
+    j["tool"] = {{"name", how.baseline ? "tomomap-baseline" : "tomomap"}, {"version", TOMOMAP_VERSION}};
     j["method"] = how.baseline ? "fpfh-ransac" : "tomomap";
+    j["grid"] = grid;
     if (extra.is_object()) j.update(extra);
     if (json_to_stdout) {
       std::cout << j.dump(2) << "\n";

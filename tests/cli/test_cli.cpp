@@ -8,6 +8,9 @@
 #include "support.hpp"
 
 using namespace tomomap;
+using tomomap::test::documentedJsonFields;
+using tomomap::test::keysOf;
+using tomomap::test::readText;
 using tomomap::test::runTomomap;
 using tomomap::test::TempDir;
 
@@ -369,4 +372,35 @@ TEST(Cli, AMapInMillimetresGetsAHintAndStatusJsonAlwaysPrintsADocument) {
   const auto j = nlohmann::json::parse(none.output.substr(open, close - open + 1));
   EXPECT_FALSE(j["running"].get<bool>());
   EXPECT_NE(j["error"].get<std::string>().find("cannot read"), std::string::npos);
+}
+
+// docs/json.md is the contract for programs that read tomomap's JSON: every
+// field it lists is written, and nothing is written that it does not list.
+TEST(Cli, TheJsonOutputIsTheDocumentedContract) {
+  TempDir dir;
+  ASSERT_EQ(runTomomap("synth -o " + (dir / "building") + " -n 2 -s 1 --scale 0.5").exit_code, 0);
+  ASSERT_EQ(runTomomap("synth -o " + (dir / "street") + " -w outdoor -n 1 -s 1 --scale 0.5").exit_code, 0);
+  const std::string b = dir / "building/";
+  const auto right =
+      runTomomap("match --json " + (dir / "right.json") + " --grid 0.1 --gt-target " + b +
+                 "map_0-gtpose.txt --gt-source " + b + "map_1-gtpose.txt " + b + "map_0.pcd " + b + "map_1.pcd");
+  ASSERT_EQ(right.exit_code, 0) << right.output;
+  const auto none = runTomomap("match --json " + (dir / "none.json") + " --grid 0.1 " + b + "map_0.pcd " +
+                               (dir / "street/map_0.pcd"));
+  ASSERT_EQ(none.exit_code, 1) << none.output;
+  const auto a = nlohmann::json::parse(readText(dir / "right.json"));
+  const auto n = nlohmann::json::parse(readText(dir / "none.json"));
+  EXPECT_EQ(a["schema_version"], 1);
+  EXPECT_EQ(a["grid"], 0.1);
+  EXPECT_EQ(a["target"], b + "map_0.pcd");
+  EXPECT_EQ(a["tool"]["name"], "tomomap");
+  EXPECT_FALSE(a["tool"]["version"].get<std::string>().empty());
+
+  std::set<std::string> written = keysOf(a);
+  for (const auto& k : keysOf(n)) written.insert(k);
+  std::set<std::string> documented = documentedJsonFields("`match --json`");
+  ASSERT_FALSE(documented.empty());
+  for (const auto& k : written) EXPECT_TRUE(documented.count(k)) << k << " is written but not in docs/json.md";
+  documented.erase("T_target_source_unleveled");  // only with --level
+  for (const auto& k : documented) EXPECT_TRUE(written.count(k)) << k << " is in docs/json.md but not written";
 }

@@ -4,12 +4,15 @@
 #include <algorithm>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "support.hpp"
 
 using namespace tomomap;
+using tomomap::test::documentedJsonFields;
+using tomomap::test::keysOf;
 using tomomap::test::runTomomap;
 using tomomap::test::TempDir;
 
@@ -76,6 +79,11 @@ TEST(Eval, CiSuiteSucceedsAndDrawsBoxPlots) {
   EXPECT_NE(r.output.find("fpfh-ransac / tomomap: median time"), std::string::npos) << r.output;
   const std::string rows = slurp(dir / "out/rows.csv");
   EXPECT_EQ(std::count(rows.begin(), rows.end(), '\n'), 1 + 6 + 2) << rows;
+  std::ifstream jsonl(dir / "out/rows.jsonl");
+  std::string first;
+  ASSERT_TRUE(std::getline(jsonl, first));
+  EXPECT_EQ(keysOf(nlohmann::json::parse(first)), documentedJsonFields("`rows.jsonl`"))
+      << "rows.jsonl as docs/json.md lists it";
   const cv::Mat plots = cv::imread(dir / "out/boxplots.png");
   ASSERT_FALSE(plots.empty());
   EXPECT_GT(plots.cols, 1000);
@@ -89,4 +97,26 @@ TEST(Eval, ASynthBlockMayNameOnlyTheSuitesMethods) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("s.toml:5:"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("not one of the suite's methods"), std::string::npos) << r.output;
+}
+
+TEST(Eval, ARunPastTheTimeoutIsKilledAndSaysSoAndTheSuiteGoesOn) {
+  TempDir dir;
+  // The baseline takes tens of seconds on this world; half a second is never enough.
+  std::ofstream(dir / "s.toml") << "name = \"t\"\nmethods = [\"fpfh-ransac\", \"tomomap\"]\n[[synth]]\nworld = "
+                                << "\"indoor\"\nseeds = [1]\nnoise = [\"low\"]\nscale = 0.5\ngrid = 0.1\n";
+  const auto r = runTomomap("eval " + (dir / "s.toml") + " --timeout 0.5 -o " + (dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("[1/2] indoor-low-1-x0.5-g0.1 fpfh-ransac: running"), std::string::npos)
+      << "said before it starts\n"
+      << r.output;
+  std::ifstream jsonl(dir / "out/rows.jsonl");
+  std::string line;
+  ASSERT_TRUE(std::getline(jsonl, line));
+  const auto baseline = nlohmann::json::parse(line);
+  EXPECT_EQ(baseline["method"], "fpfh-ransac");
+  EXPECT_EQ(baseline["exit_code"], -1);
+  EXPECT_EQ(baseline["note"], "timed out after 0.5 s");
+  EXPECT_FALSE(baseline["success"].get<bool>());
+  ASSERT_TRUE(std::getline(jsonl, line));
+  EXPECT_EQ(nlohmann::json::parse(line)["method"], "tomomap") << "the next run still ran";
 }
