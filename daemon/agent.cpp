@@ -35,7 +35,7 @@ OwnMap describeOwnMap(const Config& config) {
   const auto t0 = Clock::now();
   OwnMap own;
   auto features = [&] {
-    const Points map = loadMap(config.map, &own.nonfinite);  // dropped once described
+    const Points map = loadMap(config.map, &own.nonfinite, &own.note);  // dropped once described
     return std::make_shared<MapFeatures>(describeMap(map, config.match, nullptr, &own.cells));
   }();
   // Peers would match slanted slices: offered nowhere, refused here.
@@ -49,6 +49,7 @@ OwnMap describeOwnMap(const Config& config) {
 }
 
 void Agent::installOwnMap(OwnMap own) {
+  if (!own.note.empty()) log_.info(own.note);
   if (own.nonfinite > 0)
     log_.warning(config_.map + ": dropped " + std::to_string(own.nonfinite) +
                  " points with NaN or infinite coordinates");

@@ -40,6 +40,7 @@ struct OwnMap {
   transport::MapOffer offer;
   size_t cells = 0;      ///< voxel-filtered points
   size_t nonfinite = 0;  ///< points with NaN or infinite coordinates, dropped
+  std::string note;       ///< how the file was read, when a user should know (loadMap)
   double seconds = 0;    ///< time taken to describe it
 };
 

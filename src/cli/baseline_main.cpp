@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("-V,--version", "tomomap-baseline " TOMOMAP_VERSION);
   std::string target, source, json, gt_target, gt_source;
   baseline::FpfhParams p;
-  app.add_option("TARGET", target, "target map (.pcd, .ply, .xyz/.txt)")->required();
+  app.add_option("TARGET", target, "target map (.pcd, .ply, .xyz/.txt/.csv, OctoMap .bt/.ot)")->required();
   app.add_option("SOURCE", source, "source map")->required();
   app.add_option("-g,--grid", p.grid, "grid size g [m]; radii scale with it")->capture_default_str()->check(gridSize());
   app.add_option("--keypoint-cells", p.keypoint_cells, "keypoint spacing [g]: fewer keypoints run faster")

@@ -54,7 +54,7 @@ Command addVizCommand(CLI::App& app) {
   auto o = std::make_shared<VizOptions>();
   CLI::App* sub = app.add_subcommand(
       "viz", "Match two maps and draw the result: top-down overlay and the winning slice pairs (PNG).");
-  sub->add_option("TARGET", o->files.target, "target map (.pcd, .ply, .xyz/.txt)")->required();
+  sub->add_option("TARGET", o->files.target, "target map (.pcd, .ply, .xyz/.txt/.csv, OctoMap .bt/.ot)")->required();
   sub->add_option("SOURCE", o->files.source, "source map")->required();
   sub->add_option("-o,--out", o->out, "output folder for overlay.png and slice-pairs.png")->capture_default_str();
   sub->add_option("--pairs", o->pairs, "slice pairs to draw (most inliers first)")

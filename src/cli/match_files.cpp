@@ -23,7 +23,9 @@ MatchedFiles matchFiles(MatchFilesOptions o) {
   StageTimings timings;
   auto describe = [&](const std::string& path, const char* role) {
     size_t nonfinite = 0;
-    const Points map = loadMap(path, &nonfinite);
+    std::string note;
+    const Points map = loadMap(path, &nonfinite, &note);
+    if (!note.empty()) std::cerr << "note: " << note << "\n";
     m.inputs[role] = path;
     m.inputs[std::string(role) + "_points"] = map.size();
     m.inputs[std::string(role) + "_nonfinite_dropped"] = nonfinite;

@@ -12,9 +12,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 #include "core/map_check.hpp"
+#include "octomap_io.hpp"
 #include "pcd_check.hpp"
 
 namespace tomomap {
@@ -74,38 +76,65 @@ Points loadPcl(const std::string& path, bool ply) {
   return fromBlob(blob, path);
 }
 
+/// x, y, z from the first three whitespace-separated fields of `line`, if
+/// they are numbers ("nan" and "inf" included: the finiteness check drops them).
+std::optional<Eigen::Vector3d> threeNumbers(const std::string& line) {
+  std::istringstream fields(line);
+  std::string f[3];
+  if (!(fields >> f[0] >> f[1] >> f[2])) return std::nullopt;
+  Eigen::Vector3d v;
+  for (int a = 0; a < 3; ++a) {
+    size_t used = 0;
+    try {
+      v[a] = std::stod(f[a], &used);
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+    if (used != f[a].size()) return std::nullopt;
+  }
+  return v;
+}
+
+/// How many faces a PLY file's header declares (a mesh: PCL reads its vertices only).
+size_t plyFaces(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  size_t faces = 0;
+  for (std::string line; std::getline(in, line) && line.rfind("end_header", 0) != 0;) {
+    std::istringstream words(line);
+    std::string element, name;
+    if (words >> element >> name && element == "element" && name == "face") words >> faces;
+  }
+  return faces;
+}
+
 Points loadXyz(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open");
   Points out;
   std::string line;
+  bool header_skipped = false;
   for (size_t number = 1; std::getline(in, line); ++number) {
     const auto hash = line.find('#');
     if (hash != std::string::npos) line.erase(hash);
     if (line.find_first_not_of(" \t\r,") == std::string::npos) continue;
     std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream fields(line);
-    double x, y, z;
-    // Reading via strings lets "nan"/"inf" through to the finiteness check below.
-    std::string sx, sy, sz;
-    if (!(fields >> sx >> sy >> sz)) throw InputError(path + ":" + std::to_string(number) + ": expected 'x y z'");
-    try {
-      size_t px, py, pz;
-      x = std::stod(sx, &px);
-      y = std::stod(sy, &py);
-      z = std::stod(sz, &pz);
-      if (px != sx.size() || py != sy.size() || pz != sz.size()) throw std::invalid_argument("");
-    } catch (const std::exception&) {
-      throw InputError(path + ":" + std::to_string(number) + ": not a number in '" + line + "'");
+    const auto p = threeNumbers(line);
+    if (!p) {
+      // Only the first line may name the columns (CloudCompare writes "//X,Y,Z").
+      if (out.empty() && !header_skipped) {
+        header_skipped = true;
+        continue;
+      }
+      throw InputError(path + ":" + std::to_string(number) + ": expected 'x y z' numbers, got '" + line + "'");
     }
-    out.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+    out.push_back(p->cast<float>());
   }
   return out;
 }
 
 }  // namespace
 
-Points loadMap(const std::string& path, size_t* nonfinite) {
+Points loadMap(const std::string& path, size_t* nonfinite, std::string* note) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(path + ": no such file");
   if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a directory, not a map file");
@@ -115,12 +144,20 @@ Points loadMap(const std::string& path, size_t* nonfinite) {
   Points points;
   if (ext == ".pcd")
     points = loadPcl(path, false);
-  else if (ext == ".ply")
+  else if (ext == ".ply") {
     points = loadPcl(path, true);
-  else if (ext == ".xyz" || ext == ".txt")
+    if (const size_t faces = plyFaces(path); faces > 0 && note)
+      *note = path + ": a mesh: its " + std::to_string(points.size()) + " vertices are the map, its " +
+              std::to_string(faces) + " faces are not used";
+  }
+  else if (ext == ".xyz" || ext == ".txt" || ext == ".csv")
     points = loadXyz(path);
+  else if (ext == ".bt" || ext == ".ot")
+    points = loadOctomap(path);
+  else if (ext == ".las" || ext == ".laz")
+    throw InputError(path + ": LAS/LAZ is not read; convert it first, e.g. pdal translate " + path + " map.pcd");
   else
-    throw InputError(path + ": unknown map format '" + ext + "' (use .pcd, .ply, .xyz or .txt)");
+    throw InputError(path + ": unknown map format '" + ext + "' (use .pcd, .ply, .xyz, .txt, .csv, .bt or .ot)");
   const size_t read = points.size(), dropped = dropNonFinite(points);
   if (nonfinite) *nonfinite = dropped;
   if (dropped > 0 && points.size() < kMinMapPoints)

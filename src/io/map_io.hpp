@@ -13,12 +13,15 @@ constexpr size_t kPcdBytesPerPoint = 3 * sizeof(float);
 constexpr size_t kPcdHeaderBytes = 190;
 constexpr uint64_t binaryPcdBytes(size_t points) { return kPcdBytesPerPoint * points + kPcdHeaderBytes; }
 
-/// Loads a map: .pcd (ascii, binary, binary_compressed), .ply, or .xyz/.txt
-/// (one "x y z" per line, '#' comments). Points with a NaN or infinite
-/// coordinate are dropped and counted in `*nonfinite`. Throws InputError
-/// naming the file and the problem for a missing, unreadable, corrupt or empty
-/// map, or one with fewer than kMinMapPoints finite points.
-Points loadMap(const std::string& path, size_t* nonfinite = nullptr);
+/// Loads a map: .pcd (ascii, binary, binary_compressed), .ply (a mesh's
+/// vertices), .xyz/.txt/.csv (one "x y z" per line, commas or spaces, '#'
+/// comments, an optional first line naming the columns), or OctoMap .bt/.ot
+/// (occupied voxel centres). Points with a NaN or infinite coordinate are
+/// dropped and counted in `*nonfinite`; `*note` gets what a user should know
+/// about how the file was read (a mesh's faces unused), if anything. Throws
+/// InputError naming the file and the problem for a missing, unreadable,
+/// corrupt or empty map, or one with fewer than kMinMapPoints finite points.
+Points loadMap(const std::string& path, size_t* nonfinite = nullptr, std::string* note = nullptr);
 
 /// Writes a binary_compressed PCD (x y z float). Throws InputError on failure.
 void savePcd(const std::string& path, const Points& points);

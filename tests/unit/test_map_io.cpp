@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <octomap/OcTree.h>
 
 #include <fstream>
 
@@ -136,8 +137,63 @@ TEST(MapIo, BadXyzLineIsNamed) {
 
 TEST(MapIo, UnknownExtensionIsRejected) {
   TempDir dir;
+  write(dir / "map.e57", "x");
+  EXPECT_NE(errorOf([&] { loadMap(dir / "map.e57"); }).find("unknown map format"), std::string::npos);
   write(dir / "map.las", "x");
-  EXPECT_NE(errorOf([&] { loadMap(dir / "map.las"); }).find("unknown map format"), std::string::npos);
+  EXPECT_NE(errorOf([&] { loadMap(dir / "map.las"); }).find("pdal translate"), std::string::npos)
+      << "LAS gets a way to convert it";
+}
+
+TEST(MapIo, ACsvWithAHeaderLineLoadsAndAHeaderMidFileIsAnError) {
+  TempDir dir;
+  std::string csv = "//X,Y,Z\n";  // CloudCompare's header
+  for (const auto& q : grid(200))
+    csv += std::to_string(q.x()) + "," + std::to_string(q.y()) + "," + std::to_string(q.z()) + "\n";
+  write(dir / "a.csv", csv);
+  EXPECT_EQ(loadMap(dir / "a.csv").size(), 200u);
+  write(dir / "b.csv", csv + "X,Y,Z\n");
+  EXPECT_NE(errorOf([&] { loadMap(dir / "b.csv"); }).find("b.csv:202: expected 'x y z' numbers"), std::string::npos);
+}
+
+TEST(MapIo, AMeshPlyIsReadAsItsVerticesAndSaysSo) {
+  TempDir dir;
+  std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 200\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  for (const auto& q : grid(200))
+    ply += std::to_string(q.x()) + " " + std::to_string(q.y()) + " " + std::to_string(q.z()) + "\n";
+  ply += "3 0 1 2\n";
+  write(dir / "mesh.ply", ply);
+  std::string note;
+  EXPECT_EQ(loadMap(dir / "mesh.ply", nullptr, &note).size(), 200u);
+  EXPECT_NE(note.find("its 200 vertices are the map, its 1 faces are not used"), std::string::npos) << note;
+}
+
+TEST(MapIo, OctomapTreesLoadAsTheirOccupiedVoxels) {
+  TempDir dir;
+  // A 1 m wall of 0.05 m voxels, 20 x 20 and two thick, and a free cell that must not come back.
+  octomap::OcTree tree(0.05);
+  for (float i = 0; i < 20; ++i)
+    for (float k = 0; k < 20; ++k)
+      for (const float y : {0.025f, 0.075f})
+        tree.updateNode(octomap::point3d(0.025f + 0.05f * i, y, 0.025f + 0.05f * k), true);
+  tree.updateNode(octomap::point3d(0.5f, 0.5f, 0.5f), false);
+  tree.prune();  // 2 x 2 x 2 blocks become one leaf: they must come back voxel by voxel
+  ASSERT_LT(tree.getNumLeafNodes(), 800u);
+  ASSERT_TRUE(tree.writeBinary(dir / "wall.bt"));
+  ASSERT_TRUE(tree.write(dir / "wall.ot"));
+  for (const char* f : {"wall.bt", "wall.ot"}) {
+    const Points p = loadMap(dir / f);
+    EXPECT_EQ(p.size(), 800u) << f;
+    for (const auto& q : p) {
+      EXPECT_TRUE(std::abs(q.y() - 0.025f) < 1e-4f || std::abs(q.y() - 0.075f) < 1e-4f) << f << " " << q.y();
+      EXPECT_TRUE(q.x() > 0 && q.x() < 1 && q.z() > 0 && q.z() < 1) << f;
+    }
+  }
+  write(dir / "junk.bt", "# Octomap OcTree binary file\nres 0.05\ndata\n");
+  EXPECT_NE(errorOf([&] { loadMap(dir / "junk.bt"); }).find("junk.bt"), std::string::npos);
+  write(dir / "text.ot", "not a tree at all\n");
+  EXPECT_NE(errorOf([&] { loadMap(dir / "text.ot"); }).find("not a readable OctoMap tree"), std::string::npos);
 }
 
 TEST(PoseIo, RoundTripsAndRejectsBadFiles) {
