@@ -60,11 +60,11 @@ TEST(Daemons, ThreeAgreeOnASynthWorldWithALateJoiner) {
     agents.push_back({id, dir / ("world/map_" + std::to_string(agents.size()) + ".pcd")});
   fleet.start(agents[0], agents);
   fleet.start(agents[1], agents);
-  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 90s)) << fleet.log("alpha") << fleet.log("bravo");
+  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 240s)) << fleet.log("alpha") << fleet.log("bravo");
   // charlie joins after alpha<-bravo was agreed: it gets that result and its own pairs.
   fleet.start(agents[2], agents);
   const std::vector<std::string> ids{"alpha", "bravo", "charlie"};
-  ASSERT_TRUE(fleet.waitForTransforms(ids, 3, 120s)) << fleet.log("alpha") << fleet.log("charlie");
+  ASSERT_TRUE(fleet.waitForTransforms(ids, 3, 300s)) << fleet.log("alpha") << fleet.log("charlie");
 
   const auto gt = [&](int i) { return dir / ("world/map_" + std::to_string(i) + "-gtpose.txt"); };
   const std::map<std::string, std::pair<int, int>> pairs{

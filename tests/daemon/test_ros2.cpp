@@ -83,7 +83,7 @@ TEST(Ros2, TheFleetsFramesAreOneTreeOnTfStatic) {
   }
   for (const auto& a : agents) fleet.start(a, agents);
   const std::vector<std::string> ids{"alpha", "bravo", "charlie"};
-  ASSERT_TRUE(fleet.waitForTransforms(ids, 3, 120s)) << fleet.log("alpha") << fleet.log("charlie");
+  ASSERT_TRUE(fleet.waitForTransforms(ids, 3, 300s)) << fleet.log("alpha") << fleet.log("charlie");
   const auto agreed = fleet.transforms("alpha");
   int reliable = 0;
   for (const auto& [name, t] : agreed) reliable += t["reliable"].get<bool>();
@@ -100,7 +100,7 @@ TEST(Ros2, TheFleetsFramesAreOneTreeOnTfStatic) {
           if (msg.transforms().size() != 2) return false;
         return true;
       },
-      60s))
+      120s))
       << reader.latest().size() << " publishers heard\n"
       << fleet.log("alpha");
 
