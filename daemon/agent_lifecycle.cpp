@@ -93,6 +93,8 @@ void Agent::reload() {
     notifier_.ready();
     return;
   }
+  // Decided now: a failed join below moves `previous` back into config_.
+  const bool ros2_changed = !(next.ros2 == config_.ros2) || next.treeRoot() != config_.treeRoot();
   Config previous = std::move(config_);
   config_ = std::move(next);
   log_.setThreshold(config_.log_level);
@@ -117,7 +119,7 @@ void Agent::reload() {
       joinNetwork();  // worked before; if not, the error ends the process and systemd restarts it
     }
   }
-  if (!(previous.ros2 == config_.ros2) || previous.treeRoot() != config_.treeRoot()) startRos2();
+  if (ros2_changed) startRos2();
   watch_ = std::make_unique<MapWatch>(config_.map);
   map_touched_ = Clock::now() - kMapSettle;  // and read the map again now
   persist(true);

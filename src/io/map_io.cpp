@@ -149,11 +149,10 @@ Points loadMap(const std::string& path, size_t* nonfinite, std::string* note) {
     if (const size_t faces = plyFaces(path); faces > 0 && note)
       *note = path + ": a mesh: its " + std::to_string(points.size()) + " vertices are the map, its " +
               std::to_string(faces) + " faces are not used";
-  }
-  else if (ext == ".xyz" || ext == ".txt" || ext == ".csv")
+  } else if (ext == ".xyz" || ext == ".txt" || ext == ".csv")
     points = loadXyz(path);
   else if (ext == ".bt" || ext == ".ot")
-    points = loadOctomap(path);
+    points = loadOctomap(path, ext == ".bt");
   else if (ext == ".las" || ext == ".laz")
     throw InputError(path + ": LAS/LAZ is not read; convert it first, e.g. pdal translate " + path + " map.pcd");
   else

@@ -24,8 +24,7 @@ std::unique_ptr<octomap::OcTree> readTree(const std::string& path, bool binary) 
 
 }  // namespace
 
-Points loadOctomap(const std::string& path) {
-  const bool binary = path.size() >= 3 && path.compare(path.size() - 3, 3, ".bt") == 0;
+Points loadOctomap(const std::string& path, bool binary) {
   const auto tree = readTree(path, binary);
   const double res = tree->getResolution();
   Points out;
