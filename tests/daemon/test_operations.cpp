@@ -212,7 +212,8 @@ TEST(Operations, ADaemonBootedBeforeItsMapWaitsForItThenMatches) {
   fleet.start(agents[0], agents);
 
   ASSERT_TRUE(notify.waitFor("READY=1", 30s)) << notify.all() << fleet.log("bravo");
-  EXPECT_NE(notify.all().find("STATUS=waiting for map " + bravo_map), std::string::npos) << notify.all();
+  // STATUS follows READY: wait for it rather than assume it came in the same breath.
+  EXPECT_TRUE(notify.waitFor("STATUS=waiting for map " + bravo_map, 30s)) << notify.all();
   EXPECT_NE(fleet.log("bravo").find("ready: joined 1 peers; waiting for map " + bravo_map), std::string::npos)
       << fleet.log("bravo");
   EXPECT_TRUE(fleet.readJson("bravo", "status.json")["map"]["waiting"].get<bool>());
