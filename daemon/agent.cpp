@@ -12,7 +12,9 @@ Agent::Agent(Config config, Log& log)
       sender_(transport::streamKbps(config_.transport), fromSeconds(config_.request_interval_s)),
       peers_(config_.agent(), log, peerMemoryBytes(config_)),
       board_(config_.agent(), boardTimings(config_)),
-      worker_([this] { queue_cv_.notify_one(); }) {}
+      worker_([this] { queue_cv_.notify_one(); }) {
+  board_.setFleet(config_.peerIds());
+}
 
 void Agent::post(std::function<void()> work) {
   {
@@ -220,6 +222,7 @@ void Agent::onPeer(const std::string& id, bool alive) {
   }
   if (alive) {
     if (peers_.setAlive(id, true)) log_.info("peer " + id + " is up");
+    board_.agentUp(id);
     requestMissing(/*at_once=*/true);  // a request sent before it could hear us was lost
     // Durability is meant to give it our announcement, but Fast DDS misses a
     // late reader now and then (eProsima/Fast-DDS#3822): announce again soon.

@@ -102,6 +102,7 @@ void Agent::reload() {
   sender_.setBudget(transport::streamKbps(config_.transport), fromSeconds(config_.request_interval_s));
   peers_.setMemoryBudget(peerMemoryBytes(config_));
   board_.setTimings(boardTimings(config_));
+  board_.setFleet(config_.peerIds());
   if (!sameNetwork(previous.transport, config_.transport)) {
     log_.info("network settings changed: leaving and joining again");
     bus_.reset();
@@ -116,6 +117,7 @@ void Agent::reload() {
       log_.error(std::string("cannot join with the new settings (") + e.what() + "); back to the previous ones");
       config_ = std::move(previous);
       log_.setThreshold(config_.log_level);
+      board_.setFleet(config_.peerIds());
       joinNetwork();  // worked before; if not, the error ends the process and systemd restarts it
     }
   }

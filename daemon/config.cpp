@@ -213,6 +213,12 @@ bool Config::isPeer(const std::string& id) const {
   return false;
 }
 
+std::vector<std::string> Config::peerIds() const {
+  std::vector<std::string> ids;
+  for (const auto& p : transport.peers) ids.push_back(p.id);
+  return ids;
+}
+
 std::string Config::treeRoot() const {
   if (!ros2.root.empty()) return ros2.root;
   std::string lowest = agent();

@@ -39,6 +39,7 @@ struct Config {
 
   const std::string& agent() const { return transport.agent; }
   bool isPeer(const std::string& id) const;
+  std::vector<std::string> peerIds() const;
   /// The root of the frame tree: [ros2] root, or the lowest id in the fleet.
   std::string treeRoot() const;
 };

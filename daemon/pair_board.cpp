@@ -1,5 +1,7 @@
 #include "pair_board.hpp"
 
+#include <algorithm>
+#include <functional>
 #include <set>
 
 namespace tomomap::daemon {
@@ -26,7 +28,26 @@ const char* stateName(PairState s) {
   return "?";
 }
 
-PairBoard::PairBoard(std::string me, BoardTimings timings) : me_(std::move(me)), timings_(timings) {}
+std::vector<std::string> computeOrder(const PairKey& pair, const std::vector<std::string>& fleet) {
+  const size_t n = fleet.size();
+  const auto at = [&](const std::string& id) {
+    return static_cast<size_t>(std::lower_bound(fleet.begin(), fleet.end(), id) - fleet.begin());
+  };
+  const size_t i = at(pair.first), j = at(pair.second);
+  if (n == 0 || i >= n || j >= n || fleet[i] != pair.first || fleet[j] != pair.second) return {};
+  std::vector<std::string> order;
+  for (size_t k = 0; k < n; ++k) order.push_back(fleet[(i + j + 1 + k) % n]);
+  return order;
+}
+
+PairBoard::PairBoard(std::string me, BoardTimings timings) : me_(std::move(me)), timings_(timings) { setFleet({}); }
+
+void PairBoard::setFleet(std::vector<std::string> agents) {
+  agents.push_back(me_);
+  std::sort(agents.begin(), agents.end());
+  agents.erase(std::unique(agents.begin(), agents.end()), agents.end());
+  fleet_ = std::move(agents);
+}
 
 std::vector<AgreedTransform> PairBoard::mapAnnounced(const std::string& agent, uint64_t version) {
   maps_[agent] = {version, agent == me_};
@@ -51,8 +72,7 @@ void PairBoard::mapHeld(const std::string& agent) {
 
 void PairBoard::ownMap(uint64_t version) {
   mapAnnounced(me_, version);
-  for (auto it = own_claims_.begin(); it != own_claims_.end();)
-    it = (it->first.first == me_ || it->first.second == me_) ? own_claims_.erase(it) : std::next(it);
+  if (own_claim_ && (own_claim_->first.pair.first == me_ || own_claim_->first.pair.second == me_)) own_claim_.reset();
 }
 
 std::optional<uint64_t> PairBoard::versionOf(const std::string& agent) const {
@@ -96,18 +116,20 @@ PairBoard::Offer PairBoard::estimateSeen(AgreedTransform t) {
       return Offer::Duplicate;  // the same result again, or a duplicate computation: keep one, deterministically
   store(std::move(t));
   claims_.erase(key);
-  own_claims_.erase(key);
+  if (own_claim_ && own_claim_->first.pair == key) own_claim_.reset();
   return Offer::Stored;
 }
 
 void PairBoard::agentGone(const std::string& agent) {
+  up_.erase(agent);
   for (auto it = claims_.begin(); it != claims_.end();)
     it = it->second.claimer == agent ? claims_.erase(it) : std::next(it);
 }
 
 void PairBoard::leftNetwork() {
   claims_.clear();
-  own_claims_.clear();
+  own_claim_.reset();
+  up_.clear();
 }
 
 BoardStep PairBoard::step(Clock::time_point now) {
@@ -119,46 +141,81 @@ BoardStep PairBoard::step(Clock::time_point now) {
     }
     return out;
   }
-  std::vector<std::string> holders;  // in id order: maps_ is sorted
-  for (const auto& [id, m] : maps_)
-    if (m.held) holders.push_back(id);
-  for (size_t i = 0; i < holders.size(); ++i)
-    for (size_t j = i + 1; j < holders.size(); ++j) {
-      const PairKey key{holders[i], holders[j]};
-      const PairAt at = *heldPair(key);
-      if (settled(key)) continue;
+  if (own_claim_) {
+    settleOwnClaim(now, out);
+    if (own_claim_ || out.compute) return out;  // still settling, or computing now
+  }
+  const std::vector<PairAt> mine = claimable(now);
+  if (!mine.empty()) {
+    own_claim_ = {mine.front(), now};
+    out.claims.push_back(mine.front());
+  }
+  return out;
+}
+
+void PairBoard::settleOwnClaim(Clock::time_point now, BoardStep& out) {
+  const PairKey key = own_claim_->first.pair;
+  const std::optional<PairAt> at = heldPair(key);
+  if (!at || settled(key) || at->target_version != own_claim_->first.target_version ||
+      at->source_version != own_claim_->first.source_version) {
+    own_claim_.reset();  // claimed for maps that have changed since, or answered meanwhile
+    return;
+  }
+  if (now - own_claim_->second < timings_.claim_settle) return;
+  if (const auto other = claims_.find(key);
+      other != claims_.end() && live(other->second, *at, now) && outranks(other->second.claimer, me_)) {
+    out.yielded.push_back(pairText(key) + " to " + other->second.claimer);
+    own_claim_.reset();
+    return;
+  }
+  own_claim_.reset();
+  computing_ = at;
+  claim_renewed_ = now;
+  out.compute = at;
+}
+
+size_t PairBoard::turn(const PairKey& key) const {
+  size_t ahead = 0;
+  for (const auto& id : computeOrder(key, fleet_)) {
+    if (id == me_) return ahead;
+    ahead += up_.count(id);
+  }
+  return ahead;  // a pair outside our fleet (a peer list that differs): no turn to wait for
+}
+
+std::vector<PairAt> PairBoard::claimable(Clock::time_point now) {
+  // The agents the agreed transforms connect already, as components.
+  std::map<std::string, std::string> parent;
+  const std::function<std::string(const std::string&)> root = [&](const std::string& a) {
+    const auto it = parent.find(a);
+    return it == parent.end() || it->second == a ? a : it->second = root(it->second);
+  };
+  for (const auto& [key, t] : results_)
+    if (t.reliable && isCurrent(t)) parent[root(key.first)] = root(key.second);
+
+  std::vector<std::pair<bool, PairAt>> mine;  // (connects nothing new, pair): new links sort first
+  for (auto a = maps_.begin(); a != maps_.end(); ++a)
+    for (auto b = std::next(a); b != maps_.end(); ++b) {
+      const PairKey key{a->first, b->first};
+      const std::optional<PairAt> at = heldPair(key);
       const auto other = claims_.find(key);
-      const bool live_other = other != claims_.end() && live(other->second, at, now);
-      auto mine = own_claims_.find(key);
-      if (mine != own_claims_.end() &&
-          (mine->second.target_version != at.target_version || mine->second.source_version != at.source_version)) {
-        own_claims_.erase(mine);  // claimed for maps that have changed since
-        mine = own_claims_.end();
-      }
-      if (mine == own_claims_.end()) {
-        if (live_other) continue;  // someone else is on it
-        own_claims_[key] = {at.target_version, at.source_version, now};
-        out.claims.push_back(at);
+      if (!at || settled(key) || (other != claims_.end() && live(other->second, *at, now))) {
+        unclaimed_since_.erase(key);
         continue;
       }
-      if (now - mine->second.at < timings_.claim_settle) continue;
-      if (live_other && outranks(other->second.claimer, me_)) {
-        out.yielded.push_back(pairText(key) + " to " + other->second.claimer);
-        own_claims_.erase(mine);
-        continue;
-      }
-      computing_ = at;
-      claim_renewed_ = now;
-      out.compute = at;
-      return out;
+      const auto since = unclaimed_since_.emplace(key, now).first->second;
+      if (now - since < timings_.claim_timeout * static_cast<int>(turn(key))) continue;  // not our turn yet
+      mine.emplace_back(root(key.first) == root(key.second), *at);
     }
+  std::stable_sort(mine.begin(), mine.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::vector<PairAt> out;
+  for (auto& [known, at] : mine) out.push_back(at);
   return out;
 }
 
 void PairBoard::computed(AgreedTransform t) {
   const PairKey key = t.pair();
   if (computing_ && computing_->pair == key) computing_.reset();
-  own_claims_.erase(key);
   store(std::move(t));
 }
 
@@ -199,7 +256,7 @@ PairStatus PairBoard::status(const PairKey& key, Clock::time_point now) const {
     return {PairState::Kept, kept->second.computed_by, kept->second.reason};
   const std::optional<PairAt> at = heldPair(key);
   if (at) {
-    if (const auto mine = own_claims_.find(key); mine != own_claims_.end()) return {PairState::Claimed, me_, {}};
+    if (own_claim_ && own_claim_->first.pair == key) return {PairState::Claimed, me_, {}};
     if (const auto other = claims_.find(key); other != claims_.end() && live(other->second, *at, now))
       return {PairState::ClaimedByPeer, other->second.claimer, {}};
   }

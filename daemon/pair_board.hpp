@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -58,10 +59,19 @@ struct BoardStep {
   std::optional<PairAt> compute;     ///< start matching this pair
 };
 
+/// Who computes a pair when all is well, written once: the fleet's agents in
+/// id order, from position (i + j + 1) mod n on, where i < j are the pair's
+/// positions. Every agent derives the same order from the same fleet, so each
+/// pair has one computer without a message, and the n(n-1)/2 pairs spread
+/// evenly: each agent is first for (n-1)/2 of them, give or take one half.
+std::vector<std::string> computeOrder(const PairKey& pair, const std::vector<std::string>& fleet);
+
 class PairBoard {
  public:
   PairBoard(std::string me, BoardTimings timings);
   void setTimings(BoardTimings t) { timings_ = t; }
+  /// The agents of the fleet as this agent's config lists them (itself and its peers).
+  void setFleet(std::vector<std::string> agents);
 
   // ---- what this agent knows of each map
   /// `agent` announced `version` (not yet held, unless it is ours).
@@ -90,14 +100,20 @@ class PairBoard {
   /// same versions every agent keeps the one of the higher-ranked computer.
   enum class Offer { Stored, Duplicate, Outdated, Pending };
   Offer estimateSeen(AgreedTransform t);
-  /// A peer's participant is gone: its claims are void.
+  /// A peer's participant is up: it can compute the pairs that are its turn.
+  void agentUp(const std::string& agent) { up_.insert(agent); }
+  /// A peer's participant is gone: its claims are void and its turns pass on.
   void agentGone(const std::string& agent);
   /// This agent left the network (and joins again): every claim is void.
   void leftNetwork();
 
   // ---- this agent's decisions
-  /// Claims pairs whose maps are held and that nobody is on; starts computing
-  /// one whose claim has settled and that no higher-ranked claimer contests.
+  /// Claims one pair it is about to compute: whose maps are held, that nobody
+  /// is on, and that is its turn (computeOrder: first among the agents up; the
+  /// k-th once the pair has gone unclaimed here for k claim timeouts, so a
+  /// stuck or busy agent's pairs pass on). Of its pairs, those joining agents
+  /// the agreed transforms do not connect yet come first. Starts computing it
+  /// once the claim has settled and no higher-ranked claimer contests it.
   /// At most one computation at a time; while it runs, its claim is renewed
   /// every quarter of the claim timeout, so that a match slower than the
   /// timeout (a big map, a busy machine) is not taken over and done twice.
@@ -128,11 +144,14 @@ class PairBoard {
     uint64_t target_version = 0, source_version = 0;
     Clock::time_point seen;
   };
-  struct OwnClaim {
-    uint64_t target_version = 0, source_version = 0;
-    Clock::time_point at;
-  };
   bool live(const Claim& c, const PairAt& at, Clock::time_point now) const;
+  /// How many claim timeouts this agent waits before it claims an unclaimed
+  /// pair: its place among the agents up in the pair's computeOrder.
+  size_t turn(const PairKey& key) const;
+  /// The pairs this agent may claim now, those that connect the agreed graph first.
+  std::vector<PairAt> claimable(Clock::time_point now);
+  /// Our claim waiting to settle: computes, yields or drops it.
+  void settleOwnClaim(Clock::time_point now, BoardStep& out);
   /// Stores a result, unless it is unreliable and would replace a reliable one for earlier versions.
   void store(AgreedTransform t);
   /// Whether the current versions of a pair have an answer (reliable or not).
@@ -142,8 +161,12 @@ class PairBoard {
   std::string me_;
   BoardTimings timings_;
   std::map<std::string, MapState> maps_;
-  std::map<PairKey, Claim> claims_;         ///< the winning claim of other agents per pair
-  std::map<PairKey, OwnClaim> own_claims_;  ///< pairs we claimed, at which versions, when
+  std::map<PairKey, Claim> claims_;                                ///< the winning claim of other agents per pair
+  std::optional<std::pair<PairAt, Clock::time_point>> own_claim_;  ///< the pair we claimed, and when
+  std::vector<std::string> fleet_;                                 ///< this agent and its configured peers, in id order
+  std::set<std::string> up_;                                       ///< peers whose participant is up
+  /// Since when each held, unsettled pair has gone without a live claim here.
+  std::map<PairKey, Clock::time_point> unclaimed_since_;
   /// Estimates for versions not announced yet, per pair and computer.
   std::map<std::pair<PairKey, std::string>, AgreedTransform> pending_;
   std::optional<PairAt> computing_;

@@ -3,6 +3,10 @@
 // is injected; nothing sleeps.
 #include <gtest/gtest.h>
 
+#include <iostream>
+#include <map>
+#include <set>
+
 #include "pair_board.hpp"
 
 using namespace tomomap;
@@ -290,4 +294,210 @@ TEST(PairBoard, WithNoReliableAnswerBeforeAnUnreliableOneIsStored) {
   EXPECT_FALSE(b.results().at(kAB).reliable);
   EXPECT_EQ(b.status(kAB, t0).state, PairState::Agreed);
   EXPECT_TRUE(b.step(t0).claims.empty());
+}
+
+TEST(ComputeOrder, EveryAgentIsFirstForItsShareOfThePairs) {
+  for (const size_t n : {2u, 3u, 6u, 10u, 30u}) {
+    std::vector<std::string> fleet;
+    for (size_t i = 0; i < n; ++i) fleet.push_back("agent" + std::string(i < 10 ? "0" : "") + std::to_string(i));
+    std::map<std::string, size_t> first;
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = i + 1; j < n; ++j) {
+        const auto order = computeOrder({fleet[i], fleet[j]}, fleet);
+        ASSERT_EQ(order.size(), n);
+        EXPECT_EQ(std::set<std::string>(order.begin(), order.end()).size(), n) << "each agent once";
+        ++first[order.front()];
+      }
+    size_t most = 0, least = n * n;
+    for (const auto& id : fleet) most = std::max(most, first[id]), least = std::min(least, first[id]);
+    EXPECT_LE(most - least, 1u) << n << " agents";
+  }
+  EXPECT_TRUE(computeOrder({"alpha", "zulu"}, {"alpha", "bravo"}).empty()) << "zulu is not in this fleet";
+}
+
+namespace {
+
+/// A board of `me` in the fleet alpha, bravo, charlie, delta (those in `up`
+/// up), holding every map in `maps` at version 1.
+PairBoard fleetBoard(const std::string& me, const std::vector<std::string>& maps,
+                     const std::vector<std::string>& up = {"alpha", "bravo", "charlie", "delta"}) {
+  PairBoard b(me, timings());
+  b.setFleet({"alpha", "bravo", "charlie", "delta"});
+  for (const auto& id : up)
+    if (id != me) b.agentUp(id);
+  for (const auto& id : maps) {
+    if (id == me) {
+      b.ownMap(1);
+    } else {
+      b.mapAnnounced(id, 1);
+      b.mapHeld(id);
+    }
+  }
+  return b;
+}
+
+}  // namespace
+
+TEST(PairBoard, OnlyTheAgentWhoseTurnItIsClaimsThenTheNextAfterATimeout) {
+  const std::vector<std::string> maps{"alpha", "bravo", "charlie"};
+  const std::vector<std::string> three{"alpha", "bravo", "charlie"};
+  // alpha<-bravo in the fleet of three: charlie first, then alpha, then bravo.
+  EXPECT_EQ(computeOrder(kAB, three), (std::vector<std::string>{"charlie", "alpha", "bravo"}));
+  PairBoard alpha = fleetBoard("alpha", maps, three), bravo = fleetBoard("bravo", maps, three);
+  for (auto* b : {&alpha, &bravo})
+    for (const PairAt& c : b->step(t0).claims) EXPECT_NE(c.pair, kAB) << "charlie's turn";
+
+  // charlie holds the maps but never claims (stuck, or busy with other pairs):
+  // after one claim timeout the pair is alpha's, after two bravo's.
+  PairBoard idle_alpha = fleetBoard("alpha", {"alpha", "bravo"}, three);
+  PairBoard idle_bravo = fleetBoard("bravo", {"alpha", "bravo"}, three);
+  EXPECT_TRUE(idle_alpha.step(t0).claims.empty());
+  EXPECT_TRUE(idle_bravo.step(t0).claims.empty());
+  EXPECT_TRUE(idle_alpha.step(t0 + 7s).claims.empty());
+  ASSERT_EQ(idle_alpha.step(t0 + 8s).claims.size(), 1u) << "alpha is second in line";
+  EXPECT_TRUE(idle_bravo.step(t0 + 8s).claims.empty());
+  EXPECT_EQ(idle_bravo.step(t0 + 16s).claims.size(), 1u) << "bravo is third in line";
+
+  // charlie's participant is gone: alpha is first among those up, at once.
+  PairBoard fresh = fleetBoard("alpha", {"alpha", "bravo"}, three);
+  fresh.agentGone("charlie");
+  const BoardStep now = fresh.step(t0);
+  ASSERT_EQ(now.claims.size(), 1u);
+  EXPECT_EQ(now.claims[0].pair, kAB);
+}
+
+TEST(PairBoard, ClaimsOnlyThePairItIsAboutToComputeJoiningUnconnectedAgentsFirst) {
+  // Alone in the fleet: every pair is alpha's turn, and it claims one at a time.
+  PairBoard alpha = fleetBoard("alpha", {"alpha", "bravo", "charlie", "delta"}, {"alpha"});
+  // alpha<-charlie and bravo<-charlie are agreed: alpha, bravo and charlie are
+  // one component, delta alone; alpha<-bravo (key order's first) adds nothing.
+  for (const auto& [t, s] : {PairKey{"alpha", "charlie"}, PairKey{"bravo", "charlie"}})
+    ASSERT_EQ(alpha.estimateSeen(resultOf({{t, s}, 1, 1}, "bravo")), PairBoard::Offer::Stored);
+  std::vector<PairKey> order;
+  auto now = t0;
+  for (int round = 0; round < 4; ++round) {
+    const BoardStep claim = alpha.step(now);
+    if (claim.claims.empty()) break;
+    ASSERT_EQ(claim.claims.size(), 1u) << "one claim at a time";
+    const BoardStep go = alpha.step(now += 500ms);
+    ASSERT_TRUE(go.compute);
+    EXPECT_TRUE(alpha.step(now).claims.empty()) << "nothing else claimed while computing";
+    order.push_back(go.compute->pair);
+    alpha.computed(resultOf(*go.compute, "alpha"));
+  }
+  ASSERT_EQ(order.size(), 4u);
+  EXPECT_EQ(order[0], (PairKey{"alpha", "delta"})) << "the pair that brings delta into the frame";
+  EXPECT_EQ(order[1], (PairKey{"alpha", "bravo"})) << "then the rest, which close cycles, in key order";
+}
+
+namespace {
+
+/// N boards that hold every map, exchanging claims and estimates after every
+/// round of 100 ms; a match takes 3 s. `dies` stops stepping when it starts
+/// its first match (a killed daemon); with `gone_after` the others are told
+/// its participant left that long after (liveliness), without it only its
+/// claim's timeout tells them.
+struct FleetRun {
+  std::vector<std::string> ids;
+  std::map<PairKey, int> computations;  ///< matches started per pair
+  std::vector<size_t> per_agent;        ///< matches started per agent
+  std::vector<size_t> agreed;           ///< current results per agent at the end
+  double seconds = 0;                   ///< until every live agent held every pair
+};
+
+FleetRun simulateFleet(size_t n, std::optional<size_t> dies = {}, std::optional<Clock::duration> gone_after = {}) {
+  FleetRun run;
+  for (size_t i = 0; i < n; ++i) run.ids.push_back("r" + std::string(i < 10 ? "0" : "") + std::to_string(i));
+  std::vector<PairBoard> boards;
+  for (const auto& me : run.ids) {
+    boards.emplace_back(me, timings());
+    boards.back().setFleet(run.ids);
+    for (const auto& id : run.ids)
+      if (id != me) boards.back().agentUp(id);
+    for (const auto& id : run.ids) {
+      if (id == me) {
+        boards.back().ownMap(1);
+      } else {
+        boards.back().mapAnnounced(id, 1);
+        boards.back().mapHeld(id);
+      }
+    }
+  }
+  const size_t pairs = n * (n - 1) / 2;
+  run.per_agent.assign(n, 0);
+  std::vector<std::optional<std::pair<PairAt, Clock::time_point>>> running(n);
+  std::optional<Clock::time_point> died;
+  const size_t watcher = dies && *dies == 0 ? 1 : 0;
+  auto now = t0;
+  for (; boards[watcher].currentResults() < pairs && now < t0 + 3600s; now += 100ms) {
+    std::vector<std::pair<size_t, PairAt>> claims;
+    std::vector<AgreedTransform> results;
+    for (size_t k = 0; k < n; ++k) {
+      if (died && dies == k) continue;
+      if (running[k] && now - running[k]->second >= 3s) {
+        results.push_back(resultOf(running[k]->first, run.ids[k]));
+        boards[k].computed(results.back());
+        running[k].reset();
+      }
+      const BoardStep s = boards[k].step(now);
+      for (const auto& c : s.claims) claims.emplace_back(k, c);
+      if (s.compute) {
+        running[k] = {*s.compute, now};
+        ++run.computations[s.compute->pair];
+        ++run.per_agent[k];
+        if (dies == k) died = now;
+      }
+    }
+    for (size_t k = 0; k < n; ++k) {
+      if (died && gone_after && now - *died >= *gone_after && now - *died < *gone_after + 100ms)
+        boards[k].agentGone(run.ids[*dies]);
+      for (const auto& [from, c] : claims)
+        if (from != k) boards[k].claimSeen(run.ids[from], c, now);
+      for (const auto& r : results)
+        if (r.computed_by != run.ids[k]) boards[k].estimateSeen(r);
+    }
+  }
+  for (const auto& b : boards) run.agreed.push_back(b.currentResults());
+  run.seconds = std::chrono::duration<double>(now - t0).count();
+  return run;
+}
+
+}  // namespace
+
+TEST(PairBoard, AFleetSimulatedComputesEachPairOnceSpreadEvenly) {
+  // Each pair is computed once, no agent more than its share plus one, and
+  // the fleet's time shrinks with its size.
+  for (const size_t n : {3u, 6u, 10u, 30u}) {
+    const FleetRun run = simulateFleet(n);
+    const size_t pairs = n * (n - 1) / 2;
+    for (const size_t held : run.agreed) EXPECT_EQ(held, pairs) << n << " agents";
+    EXPECT_EQ(run.computations.size(), pairs);
+    for (const auto& [pair, times] : run.computations) EXPECT_EQ(times, 1) << pairText(pair) << ", " << n << " agents";
+    const size_t share = (pairs + n - 1) / n;
+    for (size_t k = 0; k < n; ++k) EXPECT_LE(run.per_agent[k], share + 1) << run.ids[k] << ", " << n << " agents";
+    std::cout << n << " agents, " << pairs << " pairs of 3 s: every pair agreed after " << run.seconds
+              << " s (one agent alone: " << 3.5 * static_cast<double>(pairs) << " s)\n";
+    EXPECT_LE(run.seconds, 3.6 * static_cast<double>(share) + 1) << n << " agents";
+  }
+}
+
+TEST(PairBoard, AFleetSimulatedTakesOverTheMatchOfAnAgentKilledMidway) {
+  // r02 is killed as it starts its first match. Told by liveliness (2 s) or
+  // only by its claim running out (8 s), the others compute that pair, and
+  // r02's other turns, once each; the abandoned match is the one done twice.
+  for (const bool told : {true, false}) {
+    const FleetRun run = simulateFleet(6, 2, told ? std::optional<Clock::duration>(2s) : std::nullopt);
+    for (size_t k = 0; k < 6; ++k) {
+      if (k == 2) continue;
+      EXPECT_EQ(run.agreed[k], 15u) << run.ids[k] << (told ? ", told" : ", by timeout");
+    }
+    EXPECT_EQ(run.per_agent[2], 1u);
+    int twice = 0;
+    for (const auto& [pair, times] : run.computations) {
+      EXPECT_LE(times, 2) << pairText(pair);
+      twice += times == 2;
+    }
+    EXPECT_EQ(twice, 1) << "only the killed agent's match is done again";
+    std::cout << (told ? "told by liveliness: " : "by claim timeout: ") << run.seconds << " s\n";
+  }
 }
