@@ -40,7 +40,7 @@ struct OwnMap {
   transport::MapOffer offer;
   size_t cells = 0;      ///< voxel-filtered points
   size_t nonfinite = 0;  ///< points with NaN or infinite coordinates, dropped
-  std::string note;       ///< how the file was read, when a user should know (loadMap)
+  std::string note;      ///< how the file was read, when a user should know (loadMap)
   double seconds = 0;    ///< time taken to describe it
 };
 
@@ -109,7 +109,11 @@ class Agent {
   std::shared_ptr<const MapFeatures> featuresOf(const std::string& agent) const;
 
   // ---- what it tells its operator (agent_status.cpp) and ROS 2 (agent_ros2.cpp)
+  /// Writes status.json, and transforms.json when they changed or an earlier
+  /// write failed (retried with every status write until it succeeds).
   void persist(bool transforms_changed);
+  /// At start: the transforms this agent stored before (transforms.json).
+  void restoreTransforms();
   /// Creates the /tf_static publisher when [ros2] asks for it (a failure is
   /// logged: the fleet works on without it).
   void startRos2();
@@ -146,8 +150,10 @@ class Agent {
   Counters counters_;
   std::map<std::string, std::string> other_grid_;  ///< peers whose map uses another grid, and what to say
   Clock::time_point last_status_{};
-  RejectionLog rejections_;  ///< warnings for rejected samples, bounded per sender
-  bool reannounce_ = false;  ///< a peer appeared: announce again (tick, once for peers that come together)
+  bool transforms_unwritten_ = false;  ///< transforms.json is behind: its last write failed
+  std::string write_error_;            ///< why the last write of a state file failed; empty once one succeeds
+  RejectionLog rejections_;            ///< warnings for rejected samples, bounded per sender
+  bool reannounce_ = false;            ///< a peer appeared: announce again (tick, once for peers that come together)
   Clock::time_point started_ = Clock::now();
 };
 

@@ -157,6 +157,7 @@ void Agent::tick(Clock::time_point& last_announce) {
 int Agent::run(Signals& signals) {
   log_.info(describe(config_));
   if (!createOutputDir(config_.output_dir, log_)) return 2;
+  restoreTransforms();
   // At boot the map may not be written yet: the agent joins and waits for it
   // (the folder is watched below). A map that exists but cannot be used is a
   // mistake to fix, not to wait out.

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "agent.hpp"
 #include "results/json_schema.hpp"
@@ -14,14 +15,23 @@ namespace fs = std::filesystem;
 
 void Agent::persist(bool transforms_changed) {
   const fs::path dir(config_.output_dir);
-  try {
-    if (transforms_changed) {
+  if (transforms_changed) publishTree();  // the other way results leave the daemon
+  if (transforms_changed || transforms_unwritten_) {
+    try {
       nlohmann::json list = nlohmann::json::array();
       for (const auto& [key, t] : board_.results()) list.push_back(toJson(t));
       writeJsonAtomically((dir / "transforms.json").string(),
                           {{"schema_version", kJsonSchemaVersion}, {"agent", config_.agent()}, {"transforms", list}});
-      publishTree();  // the other way results leave the daemon
+      if (transforms_unwritten_) log_.info("transforms.json written again: it holds every agreed transform");
+      transforms_unwritten_ = false;
+    } catch (const std::exception& e) {
+      // Said once per failing spell; retried with every status write (tick).
+      if (!transforms_unwritten_) log_.error(std::string("cannot write transforms.json (retrying): ") + e.what());
+      transforms_unwritten_ = true;
+      write_error_ = e.what();
     }
+  }
+  try {
     nlohmann::json peers = nlohmann::json::object();
     for (const auto& peer : config_.transport.peers) {
       peers[peer.id] = peers_.status(peer);
@@ -70,11 +80,46 @@ void Agent::persist(bool transforms_changed) {
         {"rejected_samples", counters_.rejected},
         {"dropped_impostor_samples", counters_.impostors},
         {"refused_participants", counters_.refused_participants},
-        {"secure", config_.transport.security.enabled()}};
+        {"secure", config_.transport.security.enabled()},
+        {"transforms_unwritten", transforms_unwritten_},
+        {"write_error", transforms_unwritten_ ? write_error_ : std::string()}};
     writeJsonAtomically((dir / "status.json").string(), status);
+    if (!transforms_unwritten_) write_error_.clear();
   } catch (const std::exception& e) {
-    log_.error(std::string("cannot write state: ") + e.what());
+    if (write_error_.empty()) log_.error(std::string("cannot write status.json (retrying): ") + e.what());
+    write_error_ = e.what();
   }
+}
+
+void Agent::restoreTransforms() {
+  const fs::path path = fs::path(config_.output_dir) / "transforms.json";
+  if (!fs::exists(path)) return;
+  size_t restored = 0, foreign = 0;
+  try {
+    std::ifstream in(path);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    for (const auto& entry : j.at("transforms")) {
+      AgreedTransform t = agreedFromJson(entry);
+      const auto ours = [&](const std::string& id) { return id == config_.agent() || config_.isPeer(id); };
+      if (!ours(t.target) || !ours(t.source)) {
+        ++foreign;  // a peer no longer in the config
+        continue;
+      }
+      board_.restore(std::move(t));
+      ++restored;
+    }
+  } catch (const std::exception& e) {
+    // Kept for whoever wants to look; the fleet computes the pairs again.
+    const std::string aside = path.string() + ".unreadable";
+    std::error_code ec;
+    fs::rename(path, aside, ec);
+    log_.warning(path.string() + " cannot be read (" + e.what() + "): moved to " + aside +
+                 "; starting with no stored transforms");
+    return;
+  }
+  log_.info("restored " + std::to_string(restored) + " transforms from " + path.string() +
+            (foreign ? " (" + std::to_string(foreign) + " of agents no longer in the config left out)" : "") +
+            "; each stays agreed while its maps' versions are the ones announced");
 }
 
 std::string Agent::statusLine() const {

@@ -118,6 +118,9 @@ class PairBoard {
   /// every quarter of the claim timeout, so that a match slower than the
   /// timeout (a big map, a busy machine) is not taken over and done twice.
   BoardStep step(Clock::time_point now);
+  /// A result this agent stored before it restarted (transforms.json): held
+  /// like any other, current while the maps' announced versions match it.
+  void restore(AgreedTransform t) { store(std::move(t)); }
   /// Our worker's result for the pair being computed: stored (even if the
   /// versions moved on meanwhile: then the pair is stale and is recomputed).
   void computed(AgreedTransform t);

@@ -369,3 +369,91 @@ TEST(Operations, NeitherATiltedMapNorOneThatMatchesNothingReplacesTheAgreedTrans
   EXPECT_EQ(countOf(fleet.log("bravo"), "own map is tilted"), 2u) << "once refused as an update, once at start\n"
                                                                   << fleet.log("bravo");
 }
+
+namespace {
+
+/// The pair's state in the status.json of `id`'s running process ("agreed",
+/// "stale", ...), or "" (also while the file is still its previous run's).
+std::string pairState(const Fleet& fleet, const std::string& id, const std::string& pair) {
+  const auto status = fleet.readJson(id, "status.json");
+  if (status.value("pid", 0) != fleet.pid(id)) return "";
+  for (const auto& p : status.value("pairs", nlohmann::json::array()))
+    if (p.value("pair", "") == pair) return p.value("state", "");
+  return "";
+}
+
+}  // namespace
+
+TEST(Operations, RestartedDaemonsKeepTheirAgreedTransformsWithoutComputingAgain) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  Fleet fleet(dir);
+  const auto agents = startDemoPairWithBravosMapInDir(fleet, dir, loadMap(demoRoom() + "/demo-pcd2.pcd"));
+  if (HasFailure()) return;
+  const auto agreed = fleet.transforms("bravo").at("alpha<-bravo");
+  stopAll(fleet, {"alpha", "bravo"});
+
+  // Both come back (a power cycle): each reads what it stored and neither matches again.
+  for (const auto& a : agents) fleet.start(a, agents);
+  for (const char* id : {"alpha", "bravo"})
+    ASSERT_TRUE(Fleet::waitFor([&] { return pairState(fleet, id, "alpha<-bravo") == "agreed"; }, 60s)) << fleet.log(id);
+  for (const char* id : {"alpha", "bravo"}) {
+    EXPECT_EQ(countOf(fleet.log(id), "restored 1 transforms from "), 1u) << fleet.log(id);
+    const auto t = fleet.transforms(id).at("alpha<-bravo");
+    for (const char* field : {"T_target_source", "computed_by", "computed_at_ms", "matching_seconds", "quality"})
+      EXPECT_EQ(t[field], agreed[field]) << id << ": " << field;
+  }
+  EXPECT_EQ(matchesComputed(fleet, {"alpha", "bravo"}), 0) << fleet.log("alpha") << fleet.log("bravo");
+  stopAll(fleet, {"alpha", "bravo"});
+
+  // A transforms.json cut off mid-write is set aside, not trusted, and the pair is agreed again.
+  const std::string stored = dir / "out-alpha/transforms.json";
+  const std::string text = readText(stored);
+  std::ofstream(stored, std::ios::trunc) << text.substr(0, text.size() / 2);
+  fleet.start(agents[0], agents);
+  fleet.start(agents[1], agents);
+  ASSERT_TRUE(Fleet::waitFor([&] { return pairState(fleet, "alpha", "alpha<-bravo") == "agreed"; }, 60s))
+      << fleet.log("alpha");
+  EXPECT_NE(fleet.log("alpha").find("cannot be read"), std::string::npos) << fleet.log("alpha");
+  EXPECT_TRUE(std::filesystem::exists(stored + ".unreadable"));
+  stopAll(fleet, {"alpha", "bravo"});
+}
+
+TEST(Operations, AFullOutputFolderCatchesUpOnceThereIsSpaceAgain) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  const std::string out = dir / "out-alpha";
+  std::filesystem::create_directories(out);
+  // A real full file system: a small tmpfs (root only, as CI runs).
+  if (std::system(("mount -t tmpfs -o size=256k tmpfs '" + out + "' 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "mounting a tmpfs needs root";
+  struct Unmount {
+    std::string at;
+    ~Unmount() { (void)std::system(("umount -l '" + at + "'").c_str()); }
+  } unmount{out};
+  {
+    std::ofstream filler(out + "/filler", std::ios::binary);
+    const std::string block(4096, 'x');
+    for (int i = 0; i < 1000 && filler.write(block.data(), block.size()); ++i) filler.flush();
+  }
+  Fleet fleet(dir);
+  savePcd(dir / "bravo.pcd", loadMap(demoRoom() + "/demo-pcd2.pcd"));
+  const std::vector<AgentSpec> agents{{"alpha", demoRoom() + "/demo-pcd1.pcd"}, {"bravo", dir / "bravo.pcd"}};
+  for (const auto& a : agents) fleet.start(a, agents);
+  ASSERT_TRUE(fleet.waitForTransforms({"bravo"}, 1, 60s)) << fleet.log("bravo");
+  ASSERT_TRUE(
+      Fleet::waitFor([&] { return fleet.log("alpha").find("cannot write transforms.json") != std::string::npos; }, 30s))
+      << fleet.log("alpha");
+  EXPECT_TRUE(fleet.transforms("alpha").empty()) << "the disk is full";
+
+  std::filesystem::remove(out + "/filler");
+  ASSERT_TRUE(fleet.waitForTransforms({"alpha"}, 1, 30s)) << fleet.log("alpha");
+  EXPECT_EQ(fleet.transforms("alpha").at("alpha<-bravo")["T_target_source"],
+            fleet.transforms("bravo").at("alpha<-bravo")["T_target_source"]);
+  ASSERT_TRUE(Fleet::waitFor([&] { return !fleet.readJson("alpha", "status.json").empty(); }, 30s));
+  const auto status = fleet.readJson("alpha", "status.json");
+  EXPECT_FALSE(status["transforms_unwritten"].get<bool>()) << status.dump(2);
+  EXPECT_EQ(status["write_error"], "") << status.dump(2);
+  EXPECT_NE(fleet.log("alpha").find("transforms.json written again"), std::string::npos) << fleet.log("alpha");
+  stopAll(fleet, {"alpha", "bravo"});
+}
