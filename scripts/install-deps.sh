@@ -6,7 +6,7 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake pkg-config
-  libpcl-dev libopenmpi-dev libeigen3-dev libopencv-dev liboctomap-dev
+  libpcl-dev libopenmpi-dev libeigen3-dev libopencv-dev liboctomap-dev libceres-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
   libssl-dev

@@ -16,6 +16,13 @@ uint64_t parseVersion(const std::string& text) {
   return std::stoull(text, nullptr, 16);
 }
 
+nlohmann::json toJson(const Pose4& T) {
+  const Eigen::Matrix4d M = T.matrix();
+  nlohmann::json m = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) m.push_back({M(r, 0), M(r, 1), M(r, 2), M(r, 3)});
+  return {{"x", T.x}, {"y", T.y}, {"z", T.z}, {"yaw", T.yaw}, {"matrix", m}};
+}
+
 nlohmann::json toJson(const AgreedTransform& t) {
   nlohmann::json j{{"target", t.target},
                    {"source", t.source},
@@ -26,11 +33,7 @@ nlohmann::json toJson(const AgreedTransform& t) {
                    {"computed_at_ms", t.computed_at_ms},
                    {"matching_seconds", t.seconds}};
   if (t.reliable) {
-    const Eigen::Matrix4d M = t.T_target_source.matrix();
-    nlohmann::json m = nlohmann::json::array();
-    for (int r = 0; r < 4; ++r) m.push_back({M(r, 0), M(r, 1), M(r, 2), M(r, 3)});
-    const Pose4& T = t.T_target_source;
-    j["T_target_source"] = {{"x", T.x}, {"y", T.y}, {"z", T.z}, {"yaw", T.yaw}, {"matrix", m}};
+    j["T_target_source"] = toJson(t.T_target_source);
   } else {
     j["reason"] = t.reason;
   }

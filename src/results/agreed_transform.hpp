@@ -44,6 +44,8 @@ struct AgreedTransform {
   }
 };
 
+/// A 4-DoF transform as stored: x, y, z [m], yaw [rad] and its 4x4 matrix (row-major rows).
+nlohmann::json toJson(const Pose4& T);
 nlohmann::json toJson(const AgreedTransform& t);
 /// Reads one entry of transforms.json; throws InputError naming what is wrong.
 AgreedTransform agreedFromJson(const nlohmann::json& j);
