@@ -22,7 +22,7 @@
 #include "pair_board.hpp"
 #include "peer_maps.hpp"
 #include "rejection_log.hpp"
-#include "results/tf_tree.hpp"
+#include "results/fleet_frame.hpp"
 #include "transport/bus.hpp"
 #include "transport/tf_static.hpp"
 
@@ -114,10 +114,12 @@ class Agent {
   void persist(bool transforms_changed);
   /// At start: the transforms this agent stored before (transforms.json).
   void restoreTransforms();
+  /// Builds the fleet's frame from the agreed transforms (agent_frame.cpp).
+  void updateFrame();
   /// Creates the /tf_static publisher when [ros2] asks for it (a failure is
   /// logged: the fleet works on without it).
   void startRos2();
-  /// Publishes the agreed transforms' tree on /tf_static if it changed.
+  /// Publishes the fleet frame's tree on /tf_static if it changed.
   void publishTree();
   /// One line of progress for systemd's STATUS= (and `systemctl status`).
   std::string statusLine() const;
@@ -125,6 +127,7 @@ class Agent {
   Config config_;
   Log& log_;
   std::unique_ptr<transport::Bus> bus_;
+  FleetFrame frame_;  ///< every agent's pose in the reference's map, and each pair's verdict
   std::unique_ptr<transport::TfStaticPublisher> tf_;
   std::optional<std::vector<TreeEdge>> tf_published_;  ///< what /tf_static holds; none before the first sample
   transport::BusHandlers handlers_;

@@ -1,5 +1,6 @@
-// The fleet's frames on ROS 2's /tf_static: the agreed transforms' spanning
-// tree (results/tf_tree.hpp), republished whole whenever it changes.
+// The fleet's frames on ROS 2's /tf_static: every placed map under the root
+// with its pose in the fleet's frame (results/fleet_frame.hpp), republished
+// whole whenever it changes.
 #include "agent.hpp"
 
 namespace tomomap::daemon {
@@ -34,9 +35,10 @@ void Agent::startRos2() {
 
 void Agent::publishTree() {
   if (!tf_) return;
-  std::vector<AgreedTransform> agreed;
-  for (const auto& [key, t] : board_.results()) agreed.push_back(t);
-  std::vector<TreeEdge> tree = spanningTree(agreed, config_.treeRoot());
+  uint64_t stamp_ms = 0;  // the newest transform behind the frame
+  for (const auto& [key, t] : board_.results())
+    if (t.reliable) stamp_ms = std::max(stamp_ms, t.computed_at_ms);
+  std::vector<TreeEdge> tree = treeOf(frame_, config_.treeRoot(), stamp_ms);
   // An empty tree is published too, once: a late reader then gets a sample.
   if (tf_published_ && sameTree(tree, *tf_published_)) return;
   std::vector<transport::TfFrame> frames;

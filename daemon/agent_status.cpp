@@ -15,13 +15,20 @@ namespace fs = std::filesystem;
 
 void Agent::persist(bool transforms_changed) {
   const fs::path dir(config_.output_dir);
-  if (transforms_changed) publishTree();  // the other way results leave the daemon
+  if (transforms_changed) {
+    updateFrame();
+    publishTree();  // the other way results leave the daemon
+  }
   if (transforms_changed || transforms_unwritten_) {
     try {
       nlohmann::json list = nlohmann::json::array();
       for (const auto& [key, t] : board_.results()) list.push_back(toJson(t));
       writeJsonAtomically((dir / "transforms.json").string(),
                           {{"schema_version", kJsonSchemaVersion}, {"agent", config_.agent()}, {"transforms", list}});
+      nlohmann::json frame = toJson(frame_);
+      frame["schema_version"] = kJsonSchemaVersion;
+      frame["agent"] = config_.agent();
+      writeJsonAtomically((dir / "frame.json").string(), frame);
       if (transforms_unwritten_) log_.info("transforms.json written again: it holds every agreed transform");
       transforms_unwritten_ = false;
     } catch (const std::exception& e) {

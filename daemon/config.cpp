@@ -32,6 +32,7 @@ const std::vector<std::string> kKeys{"agent",
                                      "request_interval_s",
                                      "peer_memory_mb",
                                      "test_drop_percent",
+                                     "reference",
                                      "peer.id",
                                      "peer.host",
                                      "peer.port",
@@ -219,12 +220,14 @@ std::vector<std::string> Config::peerIds() const {
   return ids;
 }
 
-std::string Config::treeRoot() const {
-  if (!ros2.root.empty()) return ros2.root;
+std::string Config::frameReference() const {
+  if (!reference.empty()) return reference;
   std::string lowest = agent();
   for (const auto& p : transport.peers) lowest = std::min(lowest, p.id);
   return lowest;
 }
+
+std::string Config::treeRoot() const { return ros2.root.empty() ? frameReference() : ros2.root; }
 
 std::string Ros2Config::frameOf(const std::string& agent) const {
   std::string f = frame;
@@ -308,7 +311,11 @@ Config loadConfig(const std::string& path) {
       t.peers.push_back(pa);
     }
   }
-  readRos2(r, root, c);  // after the peers: its root must be one of the fleet
+  // After the peers: the reference must be one of the fleet.
+  c.reference = r.text(root, "reference", std::string());
+  if (!c.reference.empty() && c.reference != c.agent() && !c.isPeer(c.reference))
+    r.fail(*root.get("reference"), "reference", "'" + c.reference + "' is neither this agent nor one of its peers");
+  readRos2(r, root, c);
   return c;
 }
 
@@ -323,7 +330,8 @@ std::string describe(const Config& c) {
     << "\n  bandwidth_kbps = " << t.bandwidth_kbps << "\n  output_dir = " << c.output_dir
     << "\n  log_level = " << levels[static_cast<int>(c.log_level)] << "\n  claim_timeout_s = " << c.claim_timeout_s
     << "\n  request_interval_s = " << c.request_interval_s << "\n  peer_memory_mb = " << c.peer_memory_mb
-    << "\n  test_drop_percent = " << t.test_drop_percent << "\n  match.max_features = " << m.features.max_features
+    << "\n  test_drop_percent = " << t.test_drop_percent << "\n  reference = " << c.frameReference()
+    << "\n  match.max_features = " << m.features.max_features
     << "\n  match.fast_threshold = " << m.features.fast_threshold
     << "\n  match.ransac_threshold_cells = " << m.ransac_threshold_cells
     << "\n  match.ransac_iterations = " << m.ransac_iterations

@@ -35,12 +35,15 @@ struct Config {
   double claim_timeout_s = 30;    ///< a claim without a result is void after this [s]
   double request_interval_s = 1;  ///< ask again for missing slices after this much silence [s]
   double peer_memory_mb = 256;    ///< memory one peer's map may take here, checked before it is allocated [MB]
+  std::string reference;          ///< the fleet frame's reference agent as configured; empty: the lowest id
   Ros2Config ros2;
 
   const std::string& agent() const { return transport.agent; }
   bool isPeer(const std::string& id) const;
   std::vector<std::string> peerIds() const;
-  /// The root of the frame tree: [ros2] root, or the lowest id in the fleet.
+  /// The agent whose map is the fleet's frame: `reference`, or the lowest id in the fleet.
+  std::string frameReference() const;
+  /// The root of the ROS 2 frame tree: [ros2] root, or the fleet frame's reference.
   std::string treeRoot() const;
 };
 

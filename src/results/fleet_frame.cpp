@@ -7,8 +7,6 @@
 #include <map>
 #include <set>
 
-#include "tf_tree.hpp"
-
 namespace tomomap {
 
 const char* consistencyName(Consistency c) {
@@ -280,6 +278,16 @@ FleetFrame buildFleetFrame(const std::vector<AgreedTransform>& agreed, const std
       frame.unreachable.push_back(agent);
   }
   return frame;
+}
+
+std::vector<TreeEdge> treeOf(const FleetFrame& frame, const std::string& root, uint64_t stamp_ms) {
+  const AgentPose* r = frame.pose(root);
+  if (!r) return {};
+  const Pose4 T_root_reference = r->T_reference_agent.inverse();
+  std::vector<TreeEdge> tree;
+  for (const auto& p : frame.poses)
+    if (p.agent != root) tree.push_back({root, p.agent, T_root_reference * p.T_reference_agent, stamp_ms});
+  return tree;
 }
 
 nlohmann::json toJson(const FleetFrame& frame) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "agreed_transform.hpp"
+#include "tf_tree.hpp"
 
 namespace tomomap {
 
@@ -63,6 +64,10 @@ struct FleetFrame {
 /// the best-supported tree.
 FleetFrame buildFleetFrame(const std::vector<AgreedTransform>& agreed, const std::vector<std::string>& agents,
                            const std::string& reference, const CycleLimits& limits);
+
+/// The frame as a tree for ROS 2's tf: every placed agent a child of `root`
+/// (T_root_agent), stamped `stamp_ms`; empty when `root` is not placed.
+std::vector<TreeEdge> treeOf(const FleetFrame& frame, const std::string& root, uint64_t stamp_ms);
 
 /// frame.json's form (docs/json.md).
 nlohmann::json toJson(const FleetFrame& frame);
