@@ -270,6 +270,10 @@ void Agent::finishCompute() {
   if (!worker_.ready()) return;
   AgreedTransform t = worker_.take();
   ++counters_.matches_computed;
+  if (t.reliable && pairText(t.pair()) == config_.test_wrong_pair) {
+    t.T_target_source = t.T_target_source * Pose4{1.5, 0, 0, radians(30)};
+    log_.warning("test_wrong_pair: " + config_.test_wrong_pair + " published moved 1.5 m and 30 deg");
+  }
   const Pose4& T = t.T_target_source;
   log_.info("computed " + pairText(t.pair()) + " in " + fixed(t.seconds, 2) + " s: " +
             (t.reliable

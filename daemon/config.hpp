@@ -36,6 +36,9 @@ struct Config {
   double request_interval_s = 1;  ///< ask again for missing slices after this much silence [s]
   double peer_memory_mb = 256;    ///< memory one peer's map may take here, checked before it is allocated [MB]
   std::string reference;          ///< the fleet frame's reference agent as configured; empty: the lowest id
+  /// Test only: this pair ("target<-source"), when computed here, is published
+  /// moved 1.5 m and 30 degrees: a wrong match on demand, for the cycle checks.
+  std::string test_wrong_pair;
   Ros2Config ros2;
 
   const std::string& agent() const { return transport.agent; }

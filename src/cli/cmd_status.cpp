@@ -68,7 +68,44 @@ std::map<std::string, uint64_t> currentVersions(const json& status) {
   return v;
 }
 
-void printHuman(const json& status, const json& transforms, bool running) {
+/// frame.json's verdict entry for a pair, or null.
+const json* verdictOf(const json& frame, const std::string& pair) {
+  const auto pairs = frame.find("pairs");  // by reference: the pointer returned points into `frame`
+  if (pairs == frame.end() || !pairs->is_array()) return nullptr;
+  for (const auto& p : *pairs)
+    if (p.value("pair", "") == pair) return &p;
+  return nullptr;
+}
+
+std::string loopText(const json& verdict) {
+  std::string loop;
+  for (const auto& id : verdict.value("cycle", json::array()))
+    loop += (loop.empty() ? "" : " -> ") + id.get<std::string>();
+  const auto& e = verdict["cycle_error"];
+  return loop + " -> " + verdict["cycle"][0].get<std::string>() + " misses by " +
+         fixed(e.value("translation_m", 0.0), 3) + " m, " + fixed(e.value("yaw_deg", 0.0), 2) + " deg";
+}
+
+/// The fleet's frame: each agent's pose in the reference's map and how it is reached.
+void printFrame(const json& frame) {
+  if (!frame.contains("agents")) return;
+  std::cout << "  frame (reference " << frame.value("reference", "?") << "; " << frame.value("optimised_pairs", 0)
+            << " consistent pairs solved together)\n";
+  for (const auto& a : frame["agents"]) {
+    const auto& T = a["T_reference_agent"];
+    std::string path;
+    for (const auto& id : a["path"]) path += (path.empty() ? "" : " -> ") + id.get<std::string>();
+    std::cout << "    " << std::left << std::setw(12) << a.value("agent", "") << std::right << "x "
+              << fixed(T.value("x", 0.0), 3) << "  y " << fixed(T.value("y", 0.0), 3) << "  z "
+              << fixed(T.value("z", 0.0), 3) << "  yaw " << fixed(degrees(T.value("yaw", 0.0)), 2) << " deg   via "
+              << path << "\n";
+  }
+  for (const auto& id : frame.value("unreachable", json::array()))
+    std::cout << "    " << std::left << std::setw(12) << id.get<std::string>() << std::right
+              << "not placed: no consistent transform joins it to the reference yet\n";
+}
+
+void printHuman(const json& status, const json& transforms, const json& frame, bool running) {
   const json& map = status["map"];
   std::cout << "tomomapd " << status.value("agent", "?") << ": "
             << (running ? "running (pid " + std::to_string(status.value("pid", 0)) + ", up " +
@@ -132,8 +169,19 @@ void printHuman(const json& status, const json& transforms, bool running) {
       std::cout << "; KEPT: for earlier maps; the current ones gave no reliable match (" << kept << ")";
     else if (!current)
       std::cout << "; STALE: a map changed since, recomputing";
+    if (const json* v = t.reliable ? verdictOf(frame, t.target + "<-" + t.source) : nullptr) {
+      const std::string verdict = v->value("verdict", "");
+      if (verdict == "inconsistent")
+        std::cout << "\n        INCONSISTENT with the fleet's other transforms: the loop " << loopText(*v)
+                  << "; left out of the frame";
+      else if (verdict == "consistent")
+        std::cout << "\n        consistent: the loop " << loopText(*v);
+      else
+        std::cout << "\n        unchecked: on no loop of transforms";
+    }
     std::cout << "\n";
   }
+  printFrame(frame);
 }
 
 int runStatus(const StatusOptions& o) {
@@ -143,17 +191,19 @@ int runStatus(const StatusOptions& o) {
                                                                      : json{{"transforms", json::array()}};
   if (!status.contains("map") || !status.contains("peers") || !transforms["transforms"].is_array())
     throw InputError((dir / "status.json").string() + ": not a tomomapd status file");
+  const json frame = std::filesystem::exists(dir / "frame.json") ? readJson(dir / "frame.json") : json::object();
   const bool fresh = (nowMs() - status.value("written_at_ms", 0.0)) / 1000 < kStaleSeconds;
   const bool running = fresh && processAlive(status.value("pid", 0));
   if (o.json) {
     std::cout << json{{"schema_version", kJsonSchemaVersion},
                       {"running", running},
                       {"status", status},
-                      {"transforms", transforms["transforms"]}}
+                      {"transforms", transforms["transforms"]},
+                      {"frame", frame}}
                      .dump(2)
               << "\n";
   } else {
-    printHuman(status, transforms, running);
+    printHuman(status, transforms, frame, running);
   }
   return running ? kExitOk : kExitNoMatch;
 }
