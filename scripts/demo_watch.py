@@ -75,6 +75,35 @@ for t, s in pairs:
           f"computed by {e['computed_by']} in {e['matching_seconds']:.2f} s; {'all three agree' if same else 'AGENTS DISAGREE'}")
     ok = ok and same
 
+print("\n== the fleet's frame (frame.json): each robot's map placed in alpha's, from all three pairs at once,")
+print("   against the ground truth")
+frame = None
+frame_deadline = time.time() + 30
+while time.time() < frame_deadline:
+    frame = load(f"{out}/alpha/frame.json")
+    if frame and len(frame["agents"]) == 3:
+        break
+    time.sleep(0.5)
+if not frame or len(frame["agents"]) != 3:
+    print("   alpha's frame does not place all three maps: " + json.dumps(frame))
+    ok = False
+else:
+    for entry in frame["agents"]:
+        a = entry["agent"]
+        T = entry["T_reference_agent"]
+        gt = mul(pose(ids[frame["reference"]]), inv(pose(ids[a])))
+        gx, gy, gz, gyaw = gt[0][3], gt[1][3], gt[2][3], math.atan2(gt[1][0], gt[0][0])
+        terr = math.dist((T["x"], T["y"], T["z"]), (gx, gy, gz))
+        yerr = abs(math.remainder(T["yaw"] - gyaw, 2 * math.pi))
+        ok = ok and terr < 0.25 and yerr < math.radians(10)
+        print(f"{a:8s} x {T['x']:8.3f} y {T['y']:8.3f} z {T['z']:7.3f} yaw {T['yaw']:7.4f}   "
+              f"truth x {gx:8.3f} y {gy:8.3f} z {gz:7.3f} yaw {gyaw:7.4f}   error {terr:.3f} m, {math.degrees(yerr):.3f} deg")
+    for v in frame["pairs"]:
+        err = v.get("cycle_error")
+        print(f"   {v['pair']}: {v['verdict']}" + (f" (the loop closes to {err['translation_m'] * 1000:.0f} mm, "
+              f"{err['yaw_deg']:.2f} deg)" if err else ""))
+        ok = ok and v["verdict"] != "inconsistent"
+
 describe = [float(m.group(1)) for a in agents
             for m in re.finditer(r"described in ([0-9.]+) s", open(f"{out}/{a}.log").read())]
 transfer = [p.get("transfer_seconds", 0) for a in agents for p in status[a]["peers"].values()]

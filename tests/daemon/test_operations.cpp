@@ -160,9 +160,10 @@ TEST(Operations, NotifiesSystemdReloadsOnSighupAndStopsCleanly) {
   EXPECT_TRUE(j["running"].get<bool>());
   EXPECT_EQ(j["status"]["agent"], "alpha");
   EXPECT_FALSE(j["status"]["peers"]["bravo"]["alive"].get<bool>());
-  EXPECT_EQ(keysOf(j), (std::set<std::string>{"schema_version", "running", "status", "transforms"}));
+  EXPECT_EQ(keysOf(j), (std::set<std::string>{"schema_version", "running", "status", "transforms", "frame"}));
   EXPECT_EQ(keysOf(j["status"]), documentedJsonFields("`status.json`")) << "status.json as docs/json.md lists it";
   EXPECT_EQ(keysOf(fleet.readJson("alpha", "transforms.json")), documentedJsonFields("`transforms.json`"));
+  EXPECT_EQ(keysOf(j["frame"]), documentedJsonFields("`frame.json`")) << "frame.json as docs/json.md lists it";
 
   // SIGHUP applies a changed config and reads the (unchanged) map again.
   const std::string config = dir / "alpha.toml";
