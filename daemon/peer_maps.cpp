@@ -11,6 +11,10 @@ namespace {
 
 constexpr size_t kTransfersKept = 8;
 constexpr int kMaxBackoffDoublings = 4;  ///< requests back off to 16 x request_interval_s at most
+/// How long samples of an unannounced version are held: an announcement is
+/// at most a few heartbeats behind its stream; samples older than this are a
+/// resend of an old version meant for another peer.
+constexpr auto kEarlyHold = std::chrono::seconds(10);
 
 }  // namespace
 
@@ -42,20 +46,49 @@ PeerMaps::Announced PeerMaps::announce(wire::MapAnnouncement a, Clock::time_poin
                            versionText(earlier->announcement().version())
                      : ""));
   p.last_progress = p.requested = p.last_request = now;
+  const size_t early = takeEarly(owner, p, now);
   Announced out{true, false, std::nullopt};
   if (p.incoming->complete()) {
     complete(owner, p);
     out.complete = true;
   } else {
-    out.request = requestFor(owner, p, /*everything=*/p.reused == 0, now);
+    out.request = requestFor(owner, p, /*everything=*/p.reused == 0 && early == 0, now);
   }
   return out;
 }
 
+void PeerMaps::holdEarly(const std::string& owner, const wire::SliceFeatures& s, size_t bytes, Clock::time_point now) {
+  Early& e = early_[owner];
+  if (e.version != s.version() || now - e.since > kEarlyHold) e = Early{s.version(), now, {}, 0};  // one version, fresh
+  if (e.bytes + bytes > memory_budget_) return;  // the owner's budget holds for these too
+  e.samples.emplace_back(s, bytes);
+  e.bytes += bytes;
+}
+
+size_t PeerMaps::takeEarly(const std::string& owner, Peer& p, Clock::time_point now) {
+  const auto it = early_.find(owner);
+  if (it == early_.end() || it->second.version != p.incoming->announcement().version()) return 0;
+  size_t taken = 0;
+  for (const auto& [s, bytes] : it->second.samples) {
+    if (p.incoming->accept(s)) continue;  // checked as any sample is: a bad one is simply not taken
+    if (p.samples++ == 0) p.first_slice = now;
+    p.bytes += bytes;
+    ++taken;
+  }
+  early_.erase(it);
+  if (taken) {
+    p.last_slice = now;
+    log_.debug(owner + ": " + std::to_string(taken) + " samples had arrived before the announcement");
+  }
+  return taken;
+}
+
 PeerMaps::Received PeerMaps::receive(const wire::SliceFeatures& s, size_t bytes, Clock::time_point now) {
   const auto it = peers_.find(s.agent().to_string());
-  if (it == peers_.end() || !it->second.incoming || it->second.incoming->announcement().version() != s.version())
-    return {};  // a version we were not told about (yet) or no longer want
+  if (it == peers_.end() || !it->second.incoming || it->second.incoming->announcement().version() != s.version()) {
+    holdEarly(s.agent().to_string(), s, bytes, now);  // its announcement may still be on the way
+    return {};
+  }
   Peer& p = it->second;
   if (p.features) return {};  // complete already: a resend meant for another peer
   Received out;

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
+#include <vector>
 
 #include "clock.hpp"
 #include "log.hpp"
@@ -39,8 +40,9 @@ class PeerMaps {
     bool completed = false;  ///< this sample completed the map: features() holds it now
     bool first = false;      ///< the first sample of this version
   };
-  /// A slice sample from its owner (`bytes` on the wire). Samples of versions
-  /// not (or no longer) wanted, and of maps already complete, are ignored.
+  /// A slice sample from its owner (`bytes` on the wire). Samples of a version
+  /// not announced yet are held until it is (early()); samples of maps
+  /// already complete are ignored.
   Received receive(const wire::SliceFeatures& s, size_t bytes, Clock::time_point now);
 
   /// Requests for the maps still incomplete that have made no progress for
@@ -63,6 +65,7 @@ class PeerMaps {
   template <typename Keep>
   void retain(Keep keep) {
     for (auto it = peers_.begin(); it != peers_.end();) it = keep(it->first) ? std::next(it) : peers_.erase(it);
+    for (auto it = early_.begin(); it != early_.end();) it = keep(it->first) ? std::next(it) : early_.erase(it);
   }
   void clearAlive() { alive_.clear(); }
 
@@ -91,6 +94,21 @@ class PeerMaps {
     size_t slices = 0, reused = 0, bytes = 0;
     double seconds = 0;
   };
+  /// Slices that came before their version's announcement. Announcements and
+  /// slices travel on different topics, so a receiver may hear a stream that
+  /// started for another peer before it hears what it belongs to; dropped,
+  /// those samples counted as delivered for RTPS and were resent only after
+  /// a long stall. Held per owner for one version, up to the memory budget.
+  struct Early {
+    uint64_t version = 0;
+    Clock::time_point since{};                                    ///< first sample held
+    std::vector<std::pair<wire::SliceFeatures, size_t>> samples;  ///< with their bytes on the wire
+    size_t bytes = 0;
+  };
+  /// Holds a sample of an unannounced version of `owner`'s map.
+  void holdEarly(const std::string& owner, const wire::SliceFeatures& s, size_t bytes, Clock::time_point now);
+  /// Takes in the held samples of the version just announced; returns how many.
+  size_t takeEarly(const std::string& owner, Peer& p, Clock::time_point now);
   /// Builds a peer's map once every slice is in, and records the transfer.
   void complete(const std::string& owner, Peer& p);
   wire::ChunkRequest requestFor(const std::string& owner, const Peer& p, bool everything, Clock::time_point now) const;
@@ -103,6 +121,7 @@ class PeerMaps {
   const Log& log_;
   size_t memory_budget_;
   std::map<std::string, Peer> peers_;
+  std::map<std::string, Early> early_;
   std::map<std::string, std::deque<Transfer>> transfers_;  ///< finished transfers per peer, latest last
   std::set<std::string> alive_;
   std::map<std::string, uint64_t> last_seen_ms_;

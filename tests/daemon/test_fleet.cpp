@@ -137,7 +137,7 @@ namespace {
 void shareAgreeAndPlace(size_t n, std::chrono::seconds deadline) {
   TempDir dir;
   const auto ids = numbered(n);
-  SynthFleet world(dir, ids, 0.5);
+  SynthFleet world(dir, ids, 0.5, std::getenv("TOMOMAP_TEST_LOGS") ? "log_level = \"debug\"\n" : "");
   Fleet fleet(dir);
   const auto t0 = std::chrono::steady_clock::now();
   for (const auto& a : world.agents) fleet.start(a, world.agents);
@@ -187,6 +187,7 @@ void shareAgreeAndPlace(size_t n, std::chrono::seconds deadline) {
     EXPECT_LT(degrees(e.yaw), 2.0) << ids[i];
     worst = std::max(worst, e.translation);
   }
+  if (std::getenv("TOMOMAP_TEST_LOGS")) std::cout << allLogs(fleet, ids);
   std::cout << poses.size() << " of " << n << " agents placed in r0's frame, worst " << worst << " m from the truth\n";
   EXPECT_GE(poses.size(), n / 2) << "most of the fleet is placed";
   stopAll(fleet, ids);

@@ -1,0 +1,87 @@
+// Receiving a peer's map without a network: a stream that arrives before its
+// announcement (they travel on different topics) is held and taken in, not
+// dropped and asked for again.
+#include <gtest/gtest.h>
+
+#include "core/matcher.hpp"
+#include "peer_maps.hpp"
+#include "synth/synth.hpp"
+#include "transport/map_offer.hpp"
+
+using namespace tomomap;
+using namespace tomomap::daemon;
+using namespace std::chrono_literals;
+
+namespace {
+
+/// bravo's offer of a small generated map at g = 0.1.
+const transport::MapOffer& bravoOffer() {
+  static const transport::MapOffer offer = [] {
+    synth::SceneParams sp;
+    sp.scale = 0.5;
+    const Points points = synth::scanScene(synth::makeScene(sp), synth::noiseLevel("low"), 1).front().points;
+    MatchParams p;
+    p.grid = 0.1;
+    return transport::makeOffer("bravo", describeMap(points, p), {}, 1000000, 4000);
+  }();
+  return offer;
+}
+
+std::vector<wire::SliceFeatures> samplesOf(const transport::MapOffer& offer) {
+  std::vector<wire::SliceFeatures> all;
+  for (const auto& [k, samples] : offer.samples) all.insert(all.end(), samples.begin(), samples.end());
+  return all;
+}
+
+const Clock::time_point t0{};
+
+/// Slices a request asks for (an empty list asks for every announced slice).
+size_t asked(const wire::ChunkRequest& r) {
+  return r.slices().empty() ? bravoOffer().announcement.slices().size() : r.slices().size();
+}
+
+}  // namespace
+
+TEST(PeerMaps, SlicesBeforeTheirAnnouncementAreHeldAndTakenIn) {
+  Log log(LogLevel::Error);
+  PeerMaps peers("alpha", log, 256u << 20);
+  const auto& offer = bravoOffer();
+  const auto all = samplesOf(offer);
+  ASSERT_GT(all.size(), 10u);
+  // The first two thirds of bravo's stream arrive before its announcement.
+  const size_t early = all.size() * 2 / 3;
+  for (size_t i = 0; i < early; ++i) {
+    const auto got = peers.receive(all[i], 1000, t0);
+    EXPECT_FALSE(got.rejection);
+    EXPECT_FALSE(got.completed);
+  }
+  EXPECT_FALSE(peers.version("bravo")) << "nothing announced yet";
+  const auto announced = peers.announce(offer.announcement, t0 + 50ms);
+  ASSERT_TRUE(announced.new_version);
+  ASSERT_TRUE(announced.request);
+  EXPECT_FALSE(announced.request->slices().empty()) << "asks for what is missing, not everything";
+  EXPECT_LT(announced.request->slices().size(), offer.announcement.slices().size());
+  for (size_t i = early; i < all.size(); ++i) peers.receive(all[i], 1000, t0 + 100ms);
+  ASSERT_NE(peers.features("bravo"), nullptr) << "the map is complete without any resend";
+}
+
+TEST(PeerMaps, HeldSlicesAreBoundedByThePeerMemoryBudgetAndByTime) {
+  Log log(LogLevel::Error);
+  const auto& offer = bravoOffer();
+  const auto all = samplesOf(offer);
+  // A budget of three samples' bytes: the rest of the early stream is not held.
+  PeerMaps small("alpha", log, 3000);
+  for (const auto& s : all) small.receive(s, 1000, t0);
+  const auto a = small.announce(offer.announcement, t0 + 50ms);
+  ASSERT_TRUE(a.request);
+  EXPECT_GE(asked(*a.request), offer.announcement.slices().size() - 3);
+
+  // Samples held longer than an announcement can lag are a resend of an old
+  // version meant for another peer: dropped.
+  PeerMaps late("alpha", log, 256u << 20);
+  for (const auto& s : all) late.receive(s, 1000, t0);
+  late.receive(all.front(), 1000, t0 + 30s);  // restarts the hold
+  const auto b = late.announce(offer.announcement, t0 + 30s);
+  ASSERT_TRUE(b.request);
+  EXPECT_GE(asked(*b.request), offer.announcement.slices().size() - 1);
+}
