@@ -47,6 +47,16 @@ void PairBoard::setFleet(std::vector<std::string> agents) {
   std::sort(agents.begin(), agents.end());
   agents.erase(std::unique(agents.begin(), agents.end()), agents.end());
   fleet_ = std::move(agents);
+  presumeUp();
+}
+
+void PairBoard::presumeUp() {
+  // Until its participant is reported gone, a peer may be on a pair already:
+  // one not discovered yet (discovery takes seconds on a busy machine) had
+  // claimed pairs this agent then computed as well.
+  up_.clear();
+  for (const auto& id : fleet_)
+    if (id != me_) up_.insert(id);
 }
 
 std::vector<AgreedTransform> PairBoard::mapAnnounced(const std::string& agent, uint64_t version) {
@@ -129,7 +139,7 @@ void PairBoard::agentGone(const std::string& agent) {
 void PairBoard::leftNetwork() {
   claims_.clear();
   own_claim_.reset();
-  up_.clear();
+  presumeUp();
 }
 
 BoardStep PairBoard::step(Clock::time_point now) {

@@ -100,16 +100,18 @@ class PairBoard {
   /// same versions every agent keeps the one of the higher-ranked computer.
   enum class Offer { Stored, Duplicate, Outdated, Pending };
   Offer estimateSeen(AgreedTransform t);
-  /// A peer's participant is up: it can compute the pairs that are its turn.
+  /// A peer's participant is up (again): it can compute the pairs that are its turn.
   void agentUp(const std::string& agent) { up_.insert(agent); }
-  /// A peer's participant is gone: its claims are void and its turns pass on.
+  /// A peer's participant is gone: its claims are void and its turns pass on
+  /// at once. Peers are presumed up until then (setFleet).
   void agentGone(const std::string& agent);
   /// This agent left the network (and joins again): every claim is void.
   void leftNetwork();
 
   // ---- this agent's decisions
   /// Claims one pair it is about to compute: whose maps are held, that nobody
-  /// is on, and that is its turn (computeOrder: first among the agents up; the
+  /// is on, and that is its turn (computeOrder: first among the agents not
+  /// reported gone; the
   /// k-th once the pair has gone unclaimed here for k claim timeouts, so a
   /// stuck or busy agent's pairs pass on). Of its pairs, those joining agents
   /// the agreed transforms do not connect yet come first. Starts computing it
@@ -151,6 +153,8 @@ class PairBoard {
   /// How many claim timeouts this agent waits before it claims an unclaimed
   /// pair: its place among the agents up in the pair's computeOrder.
   size_t turn(const PairKey& key) const;
+  /// Every peer of the fleet counts as up (at start, and after rejoining).
+  void presumeUp();
   /// The pairs this agent may claim now, those that connect the agreed graph first.
   std::vector<PairAt> claimable(Clock::time_point now);
   /// Our claim waiting to settle: computes, yields or drops it.

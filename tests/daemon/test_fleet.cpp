@@ -126,7 +126,7 @@ TEST(Fleet, FourAgentsFlagAWrongPairAndStillPlaceEveryMapRight) {
   std::cout << view.output;
   int total = 0;
   for (const auto& id : ids) total += computed(fleet, id);
-  EXPECT_EQ(total, 6) << "each pair once";
+  EXPECT_EQ(total, 6) << "each pair once\n" << allLogs(fleet, ids);
   stopAll(fleet, ids);
 }
 

@@ -323,8 +323,8 @@ PairBoard fleetBoard(const std::string& me, const std::vector<std::string>& maps
                      const std::vector<std::string>& up = {"alpha", "bravo", "charlie", "delta"}) {
   PairBoard b(me, timings());
   b.setFleet({"alpha", "bravo", "charlie", "delta"});
-  for (const auto& id : up)
-    if (id != me) b.agentUp(id);
+  for (const auto& id : {"alpha", "bravo", "charlie", "delta"})
+    if (id != me && std::find(up.begin(), up.end(), id) == up.end()) b.agentGone(id);
   for (const auto& id : maps) {
     if (id == me) {
       b.ownMap(1);
@@ -357,6 +357,16 @@ TEST(PairBoard, OnlyTheAgentWhoseTurnItIsClaimsThenTheNextAfterATimeout) {
   ASSERT_EQ(idle_alpha.step(t0 + 8s).claims.size(), 1u) << "alpha is second in line";
   EXPECT_TRUE(idle_bravo.step(t0 + 8s).claims.empty());
   EXPECT_EQ(idle_bravo.step(t0 + 16s).claims.size(), 1u) << "bravo is third in line";
+
+  // A peer not discovered yet is presumed up: it may be on the pair already
+  // (a busy machine discovers in seconds); alpha waits its turn.
+  PairBoard undiscovered("alpha", timings());
+  undiscovered.setFleet({"bravo", "charlie"});
+  undiscovered.ownMap(1);
+  undiscovered.mapAnnounced("bravo", 1);
+  undiscovered.mapHeld("bravo");
+  EXPECT_TRUE(undiscovered.step(t0).claims.empty());
+  EXPECT_EQ(undiscovered.step(t0 + 8s).claims.size(), 1u);
 
   // charlie's participant is gone: alpha is first among those up, at once.
   PairBoard fresh = fleetBoard("alpha", {"alpha", "bravo"}, three);
