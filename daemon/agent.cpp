@@ -85,7 +85,7 @@ void Agent::installOwnMap(OwnMap own) {
 }
 
 bool Agent::known(const std::string& agent, const char* what) {
-  if (agent == config_.agent() || config_.isPeer(agent)) return true;
+  if (config_.inFleet(agent)) return true;
   ++counters_.unknown_agent;
   log_.debug(std::string("dropped ") + what + " from unknown agent '" + agent + "'");
   return false;

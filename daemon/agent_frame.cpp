@@ -17,10 +17,8 @@ void Agent::updateFrame() {
   for (const auto& v : next.pairs) {
     const PairVerdict* before = frame_.verdict(v.pair);
     if (v.verdict != Consistency::Inconsistent || (before && before->verdict == Consistency::Inconsistent)) continue;
-    std::string loop;
-    for (const auto& id : v.cycle) loop += (loop.empty() ? "" : " -> ") + id;
-    log_.warning(pairText(v.pair) + " is inconsistent with the fleet's other transforms: the loop " + loop + " -> " +
-                 v.cycle.front() + " misses by " + fixed(v.cycle_translation, 2) + " m and " +
+    log_.warning(pairText(v.pair) + " is inconsistent with the fleet's other transforms: the loop " +
+                 chainText(v.cycle, /*closed=*/true) + " misses by " + fixed(v.cycle_translation, 2) + " m and " +
                  fixed(degrees(v.cycle_yaw), 1) + " deg; left out of the fleet's frame");
   }
   frame_ = std::move(next);

@@ -107,8 +107,7 @@ void Agent::restoreTransforms() {
     const nlohmann::json j = nlohmann::json::parse(in);
     for (const auto& entry : j.at("transforms")) {
       AgreedTransform t = agreedFromJson(entry);
-      const auto ours = [&](const std::string& id) { return id == config_.agent() || config_.isPeer(id); };
-      if (!ours(t.target) || !ours(t.source)) {
+      if (!config_.inFleet(t.target) || !config_.inFleet(t.source)) {
         ++foreign;  // a peer no longer in the config
         continue;
       }

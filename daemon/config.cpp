@@ -167,7 +167,7 @@ void readRos2(const Reader& r, const toml::table& root, Config& c) {
   if (ros.frame.find("{agent}") == std::string::npos)
     r.fail(*t->get("frame"), "ros2.frame", "must contain {agent} (each map needs its own frame)");
   ros.root = r.text(*t, "root", std::string());
-  if (!ros.root.empty() && ros.root != c.agent() && !c.isPeer(ros.root))
+  if (!ros.root.empty() && !c.inFleet(ros.root))
     r.fail(*t->get("root"), "ros2.root", "'" + ros.root + "' is neither this agent nor one of its peers");
   ros.localhost_only = r.flag(*t, "localhost_only", ros.localhost_only);
 }
@@ -315,7 +315,7 @@ Config loadConfig(const std::string& path) {
   }
   // After the peers: the reference must be one of the fleet.
   c.reference = r.text(root, "reference", std::string());
-  if (!c.reference.empty() && c.reference != c.agent() && !c.isPeer(c.reference))
+  if (!c.reference.empty() && !c.inFleet(c.reference))
     r.fail(*root.get("reference"), "reference", "'" + c.reference + "' is neither this agent nor one of its peers");
   readRos2(r, root, c);
   return c;
@@ -334,8 +334,7 @@ std::string describe(const Config& c) {
     << "\n  request_interval_s = " << c.request_interval_s << "\n  peer_memory_mb = " << c.peer_memory_mb
     << "\n  test_drop_percent = " << t.test_drop_percent
     << (c.test_wrong_pair.empty() ? "" : "\n  test_wrong_pair = " + c.test_wrong_pair)
-    << "\n  reference = " << c.frameReference()
-    << "\n  match.max_features = " << m.features.max_features
+    << "\n  reference = " << c.frameReference() << "\n  match.max_features = " << m.features.max_features
     << "\n  match.fast_threshold = " << m.features.fast_threshold
     << "\n  match.ransac_threshold_cells = " << m.ransac_threshold_cells
     << "\n  match.ransac_iterations = " << m.ransac_iterations

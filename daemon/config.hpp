@@ -43,6 +43,8 @@ struct Config {
 
   const std::string& agent() const { return transport.agent; }
   bool isPeer(const std::string& id) const;
+  /// This agent or one of its peers.
+  bool inFleet(const std::string& id) const { return id == agent() || isPeer(id); }
   std::vector<std::string> peerIds() const;
   /// The agent whose map is the fleet's frame: `reference`, or the lowest id in the fleet.
   std::string frameReference() const;

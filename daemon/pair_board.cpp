@@ -155,10 +155,9 @@ BoardStep PairBoard::step(Clock::time_point now) {
     settleOwnClaim(now, out);
     if (own_claim_ || out.compute) return out;  // still settling, or computing now
   }
-  const std::vector<PairAt> mine = claimable(now);
-  if (!mine.empty()) {
-    own_claim_ = {mine.front(), now};
-    out.claims.push_back(mine.front());
+  if (const std::optional<PairAt> next = nextClaim(now)) {
+    own_claim_ = {*next, now};
+    out.claims.push_back(*next);
   }
   return out;
 }
@@ -193,7 +192,7 @@ size_t PairBoard::turn(const PairKey& key) const {
   return ahead;  // a pair outside our fleet (a peer list that differs): no turn to wait for
 }
 
-std::vector<PairAt> PairBoard::claimable(Clock::time_point now) {
+std::optional<PairAt> PairBoard::nextClaim(Clock::time_point now) {
   // The agents the agreed transforms connect already, as components.
   std::map<std::string, std::string> parent;
   const std::function<std::string(const std::string&)> root = [&](const std::string& a) {
@@ -203,7 +202,7 @@ std::vector<PairAt> PairBoard::claimable(Clock::time_point now) {
   for (const auto& [key, t] : results_)
     if (t.reliable && isCurrent(t)) parent[root(key.first)] = root(key.second);
 
-  std::vector<std::pair<bool, PairAt>> mine;  // (connects nothing new, pair): new links sort first
+  std::optional<PairAt> joining, closing;  // the first in key order of each kind
   for (auto a = maps_.begin(); a != maps_.end(); ++a)
     for (auto b = std::next(a); b != maps_.end(); ++b) {
       const PairKey key{a->first, b->first};
@@ -215,12 +214,10 @@ std::vector<PairAt> PairBoard::claimable(Clock::time_point now) {
       }
       const auto since = unclaimed_since_.emplace(key, now).first->second;
       if (now - since < timings_.claim_timeout * static_cast<int>(turn(key))) continue;  // not our turn yet
-      mine.emplace_back(root(key.first) == root(key.second), *at);
+      auto& first = root(key.first) == root(key.second) ? closing : joining;
+      if (!first) first = *at;  // every pair is still visited: its unclaimed time is kept above
     }
-  std::stable_sort(mine.begin(), mine.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-  std::vector<PairAt> out;
-  for (auto& [known, at] : mine) out.push_back(at);
-  return out;
+  return joining ? joining : closing;
 }
 
 void PairBoard::computed(AgreedTransform t) {

@@ -155,8 +155,10 @@ class PairBoard {
   size_t turn(const PairKey& key) const;
   /// Every peer of the fleet counts as up (at start, and after rejoining).
   void presumeUp();
-  /// The pairs this agent may claim now, those that connect the agreed graph first.
-  std::vector<PairAt> claimable(Clock::time_point now);
+  /// The pair this agent claims next, if any is its turn: the first in key
+  /// order that joins agents the agreed transforms do not connect yet, else
+  /// the first that closes a loop.
+  std::optional<PairAt> nextClaim(Clock::time_point now);
   /// Our claim waiting to settle: computes, yields or drops it.
   void settleOwnClaim(Clock::time_point now, BoardStep& out);
   /// Stores a result, unless it is unreliable and would replace a reliable one for earlier versions.

@@ -57,6 +57,15 @@ PeerMaps::Announced PeerMaps::announce(wire::MapAnnouncement a, Clock::time_poin
   return out;
 }
 
+bool PeerMaps::tally(Peer& p, size_t bytes, Clock::time_point now) {
+  const bool first = p.samples++ == 0;
+  if (first) p.first_slice = now;
+  p.bytes += bytes;
+  p.last_slice = p.last_progress = now;
+  p.unanswered = 0;
+  return first;
+}
+
 void PeerMaps::holdEarly(const std::string& owner, const wire::SliceFeatures& s, size_t bytes, Clock::time_point now) {
   Early& e = early_[owner];
   if (e.version != s.version() || now - e.since > kEarlyHold) e = Early{s.version(), now, {}, 0};  // one version, fresh
@@ -71,15 +80,11 @@ size_t PeerMaps::takeEarly(const std::string& owner, Peer& p, Clock::time_point 
   size_t taken = 0;
   for (const auto& [s, bytes] : it->second.samples) {
     if (p.incoming->accept(s)) continue;  // checked as any sample is: a bad one is simply not taken
-    if (p.samples++ == 0) p.first_slice = now;
-    p.bytes += bytes;
+    tally(p, bytes, now);
     ++taken;
   }
   early_.erase(it);
-  if (taken) {
-    p.last_slice = now;
-    log_.debug(owner + ": " + std::to_string(taken) + " samples had arrived before the announcement");
-  }
+  if (taken) log_.debug(owner + ": " + std::to_string(taken) + " samples had arrived before the announcement");
   return taken;
 }
 
@@ -93,11 +98,7 @@ PeerMaps::Received PeerMaps::receive(const wire::SliceFeatures& s, size_t bytes,
   if (p.features) return {};  // complete already: a resend meant for another peer
   Received out;
   if ((out.rejection = p.incoming->accept(s))) return out;
-  out.first = p.samples++ == 0;
-  if (out.first) p.first_slice = now;
-  p.bytes += bytes;
-  p.last_slice = p.last_progress = now;
-  p.unanswered = 0;
+  out.first = tally(p, bytes, now);
   if (p.incoming->complete()) {
     complete(it->first, p);
     out.completed = true;

@@ -105,6 +105,8 @@ class PeerMaps {
     std::vector<std::pair<wire::SliceFeatures, size_t>> samples;  ///< with their bytes on the wire
     size_t bytes = 0;
   };
+  /// Counts an accepted sample of `bytes` as progress; returns whether it is the version's first.
+  static bool tally(Peer& p, size_t bytes, Clock::time_point now);
   /// Holds a sample of an unannounced version of `owner`'s map.
   void holdEarly(const std::string& owner, const wire::SliceFeatures& s, size_t bytes, Clock::time_point now);
   /// Takes in the held samples of the version just announced; returns how many.

@@ -94,6 +94,12 @@ inline CommandResult runBinary(const std::string& binary, const std::string& arg
 
 inline CommandResult runTomomap(const std::string& args) { return runBinary(TOMOMAP_BIN, args); }
 
+/// The expected T_target_source from two ground-truth pose files (3x4
+/// row-major, world to map): P_target * P_source^-1, the demo-room and synth convention.
+inline Pose4 groundTruth(const std::string& target_pose, const std::string& source_pose) {
+  return Pose4::fromMatrix(loadPoseFile(target_pose) * loadPoseFile(source_pose).inverse());
+}
+
 /// Demo-room maps and the expected T_1_2 (target pcd1, source pcd2).
 struct DemoPair {
   Points map1, map2;
@@ -103,8 +109,7 @@ struct DemoPair {
 inline DemoPair loadDemoPair() {
   const std::string d = demoRoom() + "/";
   DemoPair p{loadMap(d + "demo-pcd1.pcd"), loadMap(d + "demo-pcd2.pcd"), {}};
-  p.T_1_2 =
-      Pose4::fromMatrix(loadPoseFile(d + "demo-pcd1-gtpose.txt") * loadPoseFile(d + "demo-pcd2-gtpose.txt").inverse());
+  p.T_1_2 = groundTruth(d + "demo-pcd1-gtpose.txt", d + "demo-pcd2-gtpose.txt");
   return p;
 }
 

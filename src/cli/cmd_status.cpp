@@ -78,11 +78,8 @@ const json* verdictOf(const json& frame, const std::string& pair) {
 }
 
 std::string loopText(const json& verdict) {
-  std::string loop;
-  for (const auto& id : verdict.value("cycle", json::array()))
-    loop += (loop.empty() ? "" : " -> ") + id.get<std::string>();
   const auto& e = verdict["cycle_error"];
-  return loop + " -> " + verdict["cycle"][0].get<std::string>() + " misses by " +
+  return chainText(verdict["cycle"].get<std::vector<std::string>>(), /*closed=*/true) + " misses by " +
          fixed(e.value("translation_m", 0.0), 3) + " m, " + fixed(e.value("yaw_deg", 0.0), 2) + " deg";
 }
 
@@ -93,12 +90,10 @@ void printFrame(const json& frame) {
             << " consistent pairs solved together)\n";
   for (const auto& a : frame["agents"]) {
     const auto& T = a["T_reference_agent"];
-    std::string path;
-    for (const auto& id : a["path"]) path += (path.empty() ? "" : " -> ") + id.get<std::string>();
     std::cout << "    " << std::left << std::setw(12) << a.value("agent", "") << std::right << "x "
               << fixed(T.value("x", 0.0), 3) << "  y " << fixed(T.value("y", 0.0), 3) << "  z "
               << fixed(T.value("z", 0.0), 3) << "  yaw " << fixed(degrees(T.value("yaw", 0.0)), 2) << " deg   via "
-              << path << "\n";
+              << chainText(a["path"].get<std::vector<std::string>>()) << "\n";
   }
   for (const auto& id : frame.value("unreachable", json::array()))
     std::cout << "    " << std::left << std::setw(12) << id.get<std::string>() << std::right

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "exit_codes.hpp"
+#include "results/agreed_transform.hpp"
 #include "results/json_schema.hpp"
 #include "version.hpp"
 
@@ -16,16 +17,6 @@ std::string format(const char* fmt, Args... args) {
   char buf[256];
   std::snprintf(buf, sizeof buf, fmt, args...);
   return buf;
-}
-
-nlohmann::json matrixJson(const Eigen::Matrix4d& M) {
-  nlohmann::json m = nlohmann::json::array();
-  for (int r = 0; r < 4; ++r) m.push_back({M(r, 0), M(r, 1), M(r, 2), M(r, 3)});
-  return m;
-}
-
-nlohmann::json poseJson(const Pose4& p) {
-  return {{"x", p.x}, {"y", p.y}, {"z", p.z}, {"yaw", p.yaw}, {"matrix", matrixJson(p.matrix())}};
 }
 
 std::string tiltText(double tilt) { return tilt < 0 ? "not measurable" : format("%.1f deg", degrees(tilt)); }
@@ -97,7 +88,7 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
   nlohmann::json j;
   j["reliable"] = r.reliable;
   if (r.reliable) {
-    j["T_target_source"] = poseJson(r.T_target_source);
+    j["T_target_source"] = tomomap::toJson(r.T_target_source);
     if (r.T_target_source_unleveled) j["T_target_source_unleveled"] = matrixJson(*r.T_target_source_unleveled);
   } else {
     j["reason"] = r.reason;
@@ -120,7 +111,7 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
                     {"consensus", t.consensus}, {"refinement", t.refinement},
                     {"total", t.total()}};
   if (gt) {
-    j["ground_truth"] = poseJson(gt->expected);
+    j["ground_truth"] = tomomap::toJson(gt->expected);
     if (r.reliable)
       j["error"] = {{"translation", gt->error.translation}, {"yaw", gt->error.yaw}, {"success", gt->success()}};
   }

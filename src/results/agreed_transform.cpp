@@ -4,6 +4,13 @@
 
 namespace tomomap {
 
+std::string chainText(const std::vector<std::string>& agents, bool closed) {
+  std::string text;
+  for (const auto& id : agents) text += (text.empty() ? "" : " -> ") + id;
+  if (closed && !agents.empty()) text += " -> " + agents.front();
+  return text;
+}
+
 std::string versionText(uint64_t version) {
   char buf[17];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(version));
@@ -16,11 +23,14 @@ uint64_t parseVersion(const std::string& text) {
   return std::stoull(text, nullptr, 16);
 }
 
-nlohmann::json toJson(const Pose4& T) {
-  const Eigen::Matrix4d M = T.matrix();
+nlohmann::json matrixJson(const Eigen::Matrix4d& M) {
   nlohmann::json m = nlohmann::json::array();
   for (int r = 0; r < 4; ++r) m.push_back({M(r, 0), M(r, 1), M(r, 2), M(r, 3)});
-  return {{"x", T.x}, {"y", T.y}, {"z", T.z}, {"yaw", T.yaw}, {"matrix", m}};
+  return m;
+}
+
+nlohmann::json toJson(const Pose4& T) {
+  return {{"x", T.x}, {"y", T.y}, {"z", T.z}, {"yaw", T.yaw}, {"matrix", matrixJson(T.matrix())}};
 }
 
 nlohmann::json toJson(const AgreedTransform& t) {

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "core/types.hpp"
 
@@ -17,6 +18,10 @@ using PairKey = std::pair<std::string, std::string>;
 
 /// "target<-source", as logged and shown.
 inline std::string pairText(const PairKey& p) { return p.first + "<-" + p.second; }
+
+/// Agents joined by arrows, "alpha -> bravo -> charlie" (a path in the
+/// fleet's frame); with `closed`, back to the first (a loop), as logged and shown.
+std::string chainText(const std::vector<std::string>& agents, bool closed = false);
 
 /// Hex form of a map version, as logged and stored.
 std::string versionText(uint64_t version);
@@ -44,7 +49,9 @@ struct AgreedTransform {
   }
 };
 
-/// A 4-DoF transform as stored: x, y, z [m], yaw [rad] and its 4x4 matrix (row-major rows).
+/// A 4x4 matrix as four rows.
+nlohmann::json matrixJson(const Eigen::Matrix4d& M);
+/// A 4-DoF transform as stored and printed: x, y, z [m], yaw [rad] and its 4x4 matrix.
 nlohmann::json toJson(const Pose4& T);
 nlohmann::json toJson(const AgreedTransform& t);
 /// Reads one entry of transforms.json; throws InputError naming what is wrong.

@@ -175,6 +175,13 @@ inline Pose4 poseOf(const nlohmann::json& t) {
   return {T["x"].get<double>(), T["y"].get<double>(), T["z"].get<double>(), T["yaw"].get<double>()};
 }
 
+/// Matches computed across the agents `ids`, from each daemon's status.json.
+inline int matchesComputed(const Fleet& fleet, const std::vector<std::string>& ids) {
+  int n = 0;
+  for (const auto& id : ids) n += fleet.readJson(id, "status.json").value("matches_computed", 0);
+  return n;
+}
+
 /// Stops every agent with SIGTERM and checks each leaves within 2 s, cleanly.
 inline void stopAll(Fleet& fleet, const std::vector<std::string>& ids) {
   using namespace std::chrono_literals;

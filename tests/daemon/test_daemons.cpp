@@ -8,22 +8,6 @@ using namespace tomomap;
 using namespace tomomap::test;
 using namespace std::chrono_literals;
 
-namespace {
-
-/// Ground truth T_target_source for maps written by `tomomap synth` or demo-room.
-Pose4 truth(const std::string& target_pose, const std::string& source_pose) {
-  return Pose4::fromMatrix(loadPoseFile(target_pose) * loadPoseFile(source_pose).inverse());
-}
-
-/// Total matches computed across the fleet (from each agent's status).
-int computedAcrossFleet(const Fleet& fleet, const std::vector<std::string>& ids) {
-  int n = 0;
-  for (const auto& id : ids) n += fleet.readJson(id, "status.json").value("matches_computed", 0);
-  return n;
-}
-
-}  // namespace
-
 TEST(Daemons, TwoAgreeOnDemoRoomAndStopCleanly) {
   REQUIRE_DEMO_ROOM();
   TempDir dir;
@@ -36,13 +20,13 @@ TEST(Daemons, TwoAgreeOnDemoRoomAndStopCleanly) {
   const auto a = fleet.transforms("alpha").at("alpha<-bravo");
   const auto b = fleet.transforms("bravo").at("alpha<-bravo");
   ASSERT_TRUE(a["reliable"].get<bool>()) << a.dump(2);
-  const PoseError e = poseError(poseOf(a), truth(d + "demo-pcd1-gtpose.txt", d + "demo-pcd2-gtpose.txt"));
+  const PoseError e = poseError(poseOf(a), groundTruth(d + "demo-pcd1-gtpose.txt", d + "demo-pcd2-gtpose.txt"));
   EXPECT_LT(e.translation, 0.05);
   EXPECT_LT(e.yaw, 0.02);
   // Both store the same agreed result, computed once (by whoever claimed first).
   EXPECT_EQ(a["T_target_source"], b["T_target_source"]);
   EXPECT_EQ(a["computed_by"], b["computed_by"]);
-  EXPECT_EQ(computedAcrossFleet(fleet, {"alpha", "bravo"}), 1);
+  EXPECT_EQ(matchesComputed(fleet, {"alpha", "bravo"}), 1);
   // The wire carried compact features, not the map.
   const auto s = fleet.readJson("bravo", "status.json");
   EXPECT_LT(s["map"]["payload_bytes"].get<double>(), 0.25 * s["map"]["raw_bytes"].get<double>()) << s.dump(2);
@@ -73,12 +57,12 @@ TEST(Daemons, ThreeAgreeOnASynthWorldWithALateJoiner) {
     const auto ref = fleet.transforms("alpha").at(name);
     for (const auto& id : ids) EXPECT_EQ(fleet.transforms(id).at(name)["T_target_source"], ref["T_target_source"]);
     if (!ref["reliable"].get<bool>()) continue;  // maps 0 and 2 may not overlap enough
-    const PoseError e = poseError(poseOf(ref), truth(gt(idx.first), gt(idx.second)));
+    const PoseError e = poseError(poseOf(ref), groundTruth(gt(idx.first), gt(idx.second)));
     EXPECT_LT(e.translation, 5 * 0.05) << name;
     EXPECT_LT(e.yaw, 10 * kPi / 180) << name;
   }
   EXPECT_TRUE(fleet.transforms("alpha").at("alpha<-bravo")["reliable"].get<bool>());
-  EXPECT_EQ(computedAcrossFleet(fleet, ids), 3) << "each pair exactly once";
+  EXPECT_EQ(matchesComputed(fleet, ids), 3) << "each pair exactly once";
   stopAll(fleet, ids);
 }
 
@@ -106,7 +90,8 @@ TEST(Daemons, AReceiverKilledMidTransferCompletesAfterRestart) {
   ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 90s)) << fleet.log("alpha") << fleet.log("bravo");
   const auto t = fleet.transforms("bravo").at("alpha<-bravo");
   ASSERT_TRUE(t["reliable"].get<bool>());
-  EXPECT_LT(poseError(poseOf(t), truth(d + "demo-pcd1-gtpose.txt", d + "demo-pcd2-gtpose.txt")).translation, 0.05);
+  EXPECT_LT(poseError(poseOf(t), groundTruth(d + "demo-pcd1-gtpose.txt", d + "demo-pcd2-gtpose.txt")).translation,
+            0.05);
   stopAll(fleet, {"alpha", "bravo"});
 }
 

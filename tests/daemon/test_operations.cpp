@@ -109,13 +109,6 @@ void replaceMap(const std::string& path, const Points& points) {
   std::filesystem::rename(path + ".tmp", path);
 }
 
-/// Matches computed across the fleet, from each daemon's status.
-int matchesComputed(const Fleet& fleet, const std::vector<std::string>& ids) {
-  int n = 0;
-  for (const auto& id : ids) n += fleet.readJson(id, "status.json").value("matches_computed", 0);
-  return n;
-}
-
 /// alpha on demo-pcd1 and bravo on a copy of demo-pcd2 in `dir` (bravo.pcd,
 /// where a test can rewrite it), started and agreed on their pair.
 std::vector<AgentSpec> startDemoPairWithBravosMapInDir(Fleet& fleet, const TempDir& dir, const Points& bravo) {
@@ -228,8 +221,7 @@ TEST(Operations, ADaemonBootedBeforeItsMapWaitsForItThenMatches) {
   ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 90s)) << fleet.log("alpha") << fleet.log("bravo");
   const auto t = fleet.transforms("bravo").at("alpha<-bravo");
   EXPECT_TRUE(t["reliable"].get<bool>()) << t.dump(2);
-  const Pose4 gt =
-      Pose4::fromMatrix(loadPoseFile(d + "demo-pcd1-gtpose.txt") * loadPoseFile(d + "demo-pcd2-gtpose.txt").inverse());
+  const Pose4 gt = groundTruth(d + "demo-pcd1-gtpose.txt", d + "demo-pcd2-gtpose.txt");
   EXPECT_LT(poseError(poseOf(t), gt).translation, 0.05);
   EXPECT_FALSE(fleet.readJson("bravo", "status.json")["map"]["waiting"].get<bool>());
   stopAll(fleet, {"alpha", "bravo"});
@@ -276,8 +268,7 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
 
   const auto t = fleet.transforms("alpha").at("alpha<-bravo");
   ASSERT_TRUE(t["reliable"].get<bool>()) << t.dump(2);
-  const Pose4 gt =
-      Pose4::fromMatrix(loadPoseFile(d + "demo-pcd1-gtpose.txt") * loadPoseFile(d + "demo-pcd2-gtpose.txt").inverse());
+  const Pose4 gt = groundTruth(d + "demo-pcd1-gtpose.txt", d + "demo-pcd2-gtpose.txt");
   EXPECT_LT(poseError(poseOf(t), gt).translation, 0.05);
   EXPECT_EQ(fleet.transforms("bravo").at("alpha<-bravo")["T_target_source"], t["T_target_source"]);
 
