@@ -65,14 +65,18 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
     out << format(
         "quality          support %d slice pairs (runner-up %d), %zu inliers, spread x %.2f y %.2f z %.2f m\n",
         r.support, r.runner_up_support, r.inliers, r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z());
+    if (r.dense_lead > 0)
+      out << format("dense search     %s; its best pose has %.2fx the telling cells of the next\n",
+                    r.method == "dense" ? "found this answer (the features found none)" : "ran beside the features",
+                    r.dense_lead);
     out << "tilt             target " << tiltText(r.target_tilt) << ", source " << tiltText(r.source_tilt) << "\n";
     out << format("slices           target %d (%zu features), source %d (%zu features), %zu slice pairs\n",
                   r.target_slices, r.target_features, r.source_slices, r.source_features, r.slice_pairs);
     const auto& t = r.timings;
     out << format(
         "time             %.3f s: voxel %.3f, slicing %.3f, features %.3f, pair matching %.3f, "
-        "consensus %.3f, refinement %.3f\n",
-        t.total(), t.voxel, t.slicing, t.features, t.pair_matching, t.consensus, t.refinement);
+        "consensus %.3f, refinement %.3f, dense search %.3f\n",
+        t.total(), t.voxel, t.slicing, t.features, t.pair_matching, t.consensus, t.refinement, t.dense);
   }
   if (gt) {
     const auto& e = gt->expected;
@@ -94,7 +98,9 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
     j["reason"] = r.reason;
   }
   j["tilt_deg"] = {{"target", tiltJson(r.target_tilt)}, {"source", tiltJson(r.source_tilt)}};
-  j["quality"] = {{"support", r.support},
+  j["quality"] = {{"method", r.method},
+                  {"dense_lead", r.dense_lead},
+                  {"support", r.support},
                   {"height_offset_slices", r.height_offset},
                   {"runner_up_support", r.runner_up_support},
                   {"runner_up_offset_slices", r.runner_up_offset},
@@ -109,7 +115,7 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
   j["timings_s"] = {{"voxel", t.voxel},         {"slicing", t.slicing},
                     {"features", t.features},   {"pair_matching", t.pair_matching},
                     {"consensus", t.consensus}, {"refinement", t.refinement},
-                    {"total", t.total()}};
+                    {"dense", t.dense},         {"total", t.total()}};
   if (gt) {
     j["ground_truth"] = tomomap::toJson(gt->expected);
     if (r.reliable)

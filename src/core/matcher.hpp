@@ -11,8 +11,8 @@ namespace tomomap {
 
 /// Wall-clock seconds per stage.
 struct StageTimings {
-  double voxel = 0, slicing = 0, features = 0, pair_matching = 0, consensus = 0, refinement = 0;
-  double total() const { return voxel + slicing + features + pair_matching + consensus + refinement; }
+  double voxel = 0, slicing = 0, features = 0, pair_matching = 0, consensus = 0, refinement = 0, dense = 0;
+  double total() const { return voxel + slicing + features + pair_matching + consensus + refinement + dense; }
   /// Takes the map-description stages (as describeMap fills them) from `d`.
   void takeDescription(const StageTimings& d) {
     voxel = d.voxel;
@@ -41,6 +41,12 @@ struct MatchResult {
   /// The transform to apply to source points to bring them into the target's frame.
   Eigen::Matrix4d matrix() const { return T_target_source_unleveled.value_or(T_target_source.matrix()); }
 
+  /// What found T: "features" (the tomographic match) or "dense" (the dense
+  /// search of small maps, dense_search.hpp, when the features found no reliable answer).
+  std::string method = "features";
+  /// Small maps only: the dense search's winner over its best other pose, in
+  /// telling inliers (dense_search.hpp); 0 when it did not run.
+  double dense_lead = 0;
   int support = 0;                                          ///< agreeing slice pairs at the winning height offset
   int runner_up_support = 0;                                ///< best support of another answer (OffsetChoice)
   int runner_up_offset = 0;                                 ///< its height offset [slices]

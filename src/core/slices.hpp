@@ -31,6 +31,8 @@ struct SliceStack {
   SliceGrid grid;
   std::vector<std::vector<uint32_t>> cells;  ///< per slice; empty = too sparse to describe
   size_t stray = 0;                          ///< points left out as stray returns (map_bounds.hpp)
+  /// Some slices' cells are not here: they crossed the network as features.
+  bool partial = false;
 
   int size() const { return static_cast<int>(cells.size()); }
   /// Renders slice k as a CV_8U image, 255 = occupied, with `pad` empty pixels

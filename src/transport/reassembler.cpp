@@ -124,6 +124,7 @@ MapFeatures Reassembler::build() const {
     else
       sent_as_features.push_back(featuresFromWire(index, parts, stack.grid));
   }
+  stack.partial = !sent_as_features.empty();
   MapFeatures out = extractFeatures(std::move(stack), featureParamsOf(a));
   for (auto& s : sent_as_features) out.slices.push_back(std::move(s));
   std::sort(out.slices.begin(), out.slices.end(),

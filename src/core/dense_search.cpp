@@ -1,0 +1,231 @@
+#include "dense_search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "dense_refine.hpp"
+
+namespace tomomap {
+namespace {
+
+int coarsening(const SliceStack& s, int side) {
+  const int longest = std::max({s.grid.width, s.grid.height, s.size()});
+  return std::max(1, (longest + side - 1) / side);
+}
+
+/// An occupied cell's centre [m], its slice, and whether it tells places apart.
+struct Cell {
+  Eigen::Vector2d p;
+  int slice;
+  bool telling;
+};
+
+/// A room's walls, floor and ceiling fit it turned by a half or a quarter turn
+/// as well as the right way; what tells the turns apart is everything else.
+/// So a cell is "telling" unless its column is occupied in most slices (a
+/// wall) or its slice is mostly occupied (a floor or a ceiling).
+std::vector<Cell> cellsOf(const SliceStack& s) {
+  const auto w = static_cast<uint32_t>(s.grid.width);
+  std::vector<uint16_t> column(static_cast<size_t>(s.grid.width) * static_cast<size_t>(s.grid.height), 0);
+  int occupied_slices = 0;
+  size_t largest = 0;
+  for (const auto& cells : s.cells) {
+    occupied_slices += !cells.empty();
+    largest = std::max(largest, cells.size());
+    for (uint32_t idx : cells) ++column[idx];
+  }
+  std::vector<Cell> out;
+  for (int k = 0; k < s.size(); ++k) {
+    const auto& cells = s.cells[static_cast<size_t>(k)];
+    const bool flat = cells.size() * 2 > largest;
+    for (uint32_t idx : cells)
+      out.push_back({s.grid.toMetres(static_cast<float>(idx % w), static_cast<float>(idx / w)).cast<double>(), k,
+                     !flat && column[idx] * 2 < occupied_slices});
+  }
+  return out;
+}
+
+/// A stack of coarse binary images, transformed to the frequency domain
+/// (OpenCV's packed real spectra) at a common padded size.
+struct Spectra {
+  std::vector<cv::Mat> slices;  ///< empty Mat = no occupied cell in that coarse slice
+};
+
+Spectra transform(std::vector<cv::Mat>& images, cv::Size padded) {
+  Spectra s;
+  for (auto& img : images) {
+    if (cv::countNonZero(img) == 0) {
+      s.slices.emplace_back();
+      continue;
+    }
+    cv::Mat big = cv::Mat::zeros(padded, CV_32F), spectrum;
+    img.copyTo(big(cv::Rect(0, 0, img.cols, img.rows)));
+    cv::dft(big, spectrum);
+    s.slices.push_back(spectrum);
+  }
+  return s;
+}
+
+/// The best shift at one (yaw, coarse height offset).
+struct Peak {
+  double score = 0;
+  int yaw_step = 0, dz = 0, dx = 0, dy = 0;
+};
+
+/// How many of the source cells `T` at `offset` lands on a dilated target cell.
+struct Tally {
+  size_t inliers = 0, telling = 0;
+  int slices = 0;  ///< source slices with at least half their cells on the target
+};
+
+Tally countInliers(const std::vector<cv::Mat>& dilated, const SliceGrid& tg, const std::vector<Cell>& source,
+                   int offset, const Rigid2D& T, int source_slices) {
+  Tally t;
+  std::vector<size_t> on(static_cast<size_t>(source_slices), 0), all(static_cast<size_t>(source_slices), 0);
+  for (const Cell& c : source) {
+    const int i = c.slice + offset;
+    if (i < 0 || i >= static_cast<int>(dilated.size()) || dilated[static_cast<size_t>(i)].empty()) continue;
+    ++all[static_cast<size_t>(c.slice)];
+    const Eigen::Vector2d q = T.apply(c.p);
+    const Eigen::Vector2d f = tg.toPixel(q.x(), q.y());
+    const int u = static_cast<int>(std::lround(f.x())), v = static_cast<int>(std::lround(f.y()));
+    if (u < 0 || v < 0 || u >= tg.width || v >= tg.height || !dilated[static_cast<size_t>(i)].at<uint8_t>(v, u))
+      continue;
+    ++t.inliers;
+    t.telling += c.telling;
+    ++on[static_cast<size_t>(c.slice)];
+  }
+  for (size_t k = 0; k < on.size(); ++k) t.slices += all[k] > 0 && 2 * on[k] >= all[k];
+  return t;
+}
+
+}  // namespace
+
+bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params) {
+  return stack.size() > 0 && !stack.partial && coarsening(stack, params.coarse_side) <= kMaxCoarsening;
+}
+
+DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, const ConsensusParams& same,
+                          const Eigen::Vector2d& pivot, const DenseSearchParams& params) {
+  DenseSearch out;
+  if (!denseSearchable(target, params) || !denseSearchable(source, params)) return out;
+  const std::vector<Cell> source_cells = cellsOf(source);
+  if (source_cells.empty()) return out;
+  out.searched = true;
+  out.source_cells = source_cells.size();
+
+  const SliceGrid& tg = target.grid;
+  const SliceGrid& sg = source.grid;
+  const int c = std::max(coarsening(target, params.coarse_side), coarsening(source, params.coarse_side));
+  const double C = c * tg.cell;  // coarse cell [m]
+
+  // Target: coarse binary images, one per c slices.
+  const int xt = (tg.width + c - 1) / c, yt = (tg.height + c - 1) / c, zt = (target.size() + c - 1) / c;
+  // Source: turned about its raster's centre, so its coarse raster is a square
+  // that holds it at any yaw.
+  const Eigen::Vector2d centre(sg.x_min + 0.5 * sg.width * sg.cell, sg.y_min + 0.5 * sg.height * sg.cell);
+  const double radius = 0.5 * sg.cell * std::hypot(sg.width, sg.height) + sg.cell;
+  const int xs = static_cast<int>(std::ceil(2.0 * radius / C)) + 1, zs = (source.size() + c - 1) / c;
+  const cv::Size padded(cv::getOptimalDFTSize(xt + xs - 1), cv::getOptimalDFTSize(yt + xs - 1));
+
+  std::vector<cv::Mat> timg(static_cast<size_t>(zt));
+  for (auto& m : timg) m = cv::Mat::zeros(yt, xt, CV_32F);
+  const auto tw = static_cast<uint32_t>(tg.width);
+  for (int k = 0; k < target.size(); ++k)
+    for (uint32_t idx : target.cells[static_cast<size_t>(k)])
+      timg[static_cast<size_t>(k / c)].at<float>(static_cast<int>(idx / tw) / c, static_cast<int>(idx % tw) / c) = 1.f;
+  const Spectra tspec = transform(timg, padded);
+
+  const int steps = std::max(1, static_cast<int>(std::lround(2.0 * kPi / params.yaw_step)));
+  std::vector<std::vector<Peak>> peaks(static_cast<size_t>(steps));
+#pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
+  for (int step = 0; step < steps; ++step) {
+    const double yaw = 2.0 * kPi * step / steps, cs = std::cos(yaw), sn = std::sin(yaw);
+    std::vector<cv::Mat> simg(static_cast<size_t>(zs));
+    for (auto& m : simg) m = cv::Mat::zeros(xs, xs, CV_32F);
+    for (const Cell& cell : source_cells) {
+      const Eigen::Vector2d d = cell.p - centre;
+      const int u = static_cast<int>((cs * d.x() - sn * d.y() + radius) / C);
+      const int v = static_cast<int>((sn * d.x() + cs * d.y() + radius) / C);
+      simg[static_cast<size_t>(cell.slice / c)].at<float>(v, u) = 1.f;
+    }
+    const Spectra sspec = transform(simg, padded);
+    cv::Mat acc, product, corr;
+    for (int dz = -(zs - 1); dz <= zt - 1; ++dz) {
+      bool any = false;
+      for (int z = std::max(0, -dz); z < zs && z + dz < zt; ++z) {
+        const cv::Mat& a = tspec.slices[static_cast<size_t>(z + dz)];
+        const cv::Mat& b = sspec.slices[static_cast<size_t>(z)];
+        if (a.empty() || b.empty()) continue;
+        cv::mulSpectrums(a, b, product, 0, true);
+        if (any)
+          acc += product;
+        else
+          product.copyTo(acc);
+        any = true;
+      }
+      if (!any) continue;
+      cv::dft(acc, corr, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+      double best = 0;
+      cv::Point at;
+      cv::minMaxLoc(corr, nullptr, &best, nullptr, &at);
+      const int dx = at.x < xt ? at.x : at.x - padded.width, dy = at.y < yt ? at.y : at.y - padded.height;
+      peaks[static_cast<size_t>(step)].push_back({best, step, dz, dx, dy});
+    }
+  }
+
+  // Coarse peaks to poses: a source point p lands in coarse cell
+  // floor((R(yaw)(p - centre) + radius) / C) + (dx, dy) of the target.
+  const auto poseOf = [&](const Peak& k) {
+    const double yaw = 2.0 * kPi * k.yaw_step / steps;
+    Rigid2D T{yaw, Eigen::Vector2d::Zero()};
+    const Eigen::Vector2d turned_centre = Rigid2D{yaw, Eigen::Vector2d::Zero()}.apply(centre);
+    T.t = Eigen::Vector2d(tg.x_min + radius + k.dx * C, tg.y_min + radius + k.dy * C) - turned_centre;
+    return DensePose{T, k.dz * c, 0};
+  };
+  const auto isSame = [&](const DensePose& a, const DensePose& b) {
+    return std::abs(a.offset - b.offset) <= c && agree(a.transform, b.transform, same, pivot);
+  };
+  std::vector<Peak> all;
+  for (auto& p : peaks) all.insert(all.end(), p.begin(), p.end());
+  std::stable_sort(all.begin(), all.end(), [](const Peak& a, const Peak& b) { return a.score > b.score; });
+  std::vector<DensePose> coarse;
+  for (const Peak& k : all) {
+    if (static_cast<int>(coarse.size()) >= params.candidates) break;
+    const DensePose p = poseOf(k);
+    if (std::none_of(coarse.begin(), coarse.end(), [&](const DensePose& q) { return isSame(p, q); }))
+      coarse.push_back(p);
+  }
+
+  // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
+  std::vector<cv::Mat> dilated(static_cast<size_t>(target.size()));
+  const int r = static_cast<int>(std::floor(params.inlier_radius_cells));
+  const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
+  for (int k = 0; k < target.size(); ++k)
+    if (!target.cells[static_cast<size_t>(k)].empty())
+      cv::dilate(target.image(k), dilated[static_cast<size_t>(k)], disk);
+  std::vector<DensePose> refined(coarse.size());
+#pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
+  for (size_t n = 0; n < coarse.size(); ++n) {
+    DensePose p = coarse[n];
+    const auto tallyAt = [&](int o) { return countInliers(dilated, tg, source_cells, o, p.transform, source.size()); };
+    const auto bestOffsetNear = [&](int middle, int reach) {
+      for (int o = middle - reach; o <= middle + reach; ++o)
+        if (const Tally t = tallyAt(o); o == middle - reach || t.inliers > p.inliers)
+          p.inliers = t.inliers, p.telling_inliers = t.telling, p.support = t.slices, p.offset = o;
+    };
+    bestOffsetNear(p.offset, c - 1);
+    p.transform = refineOnOccupancy(target, source, p.offset, p.transform).transform;
+    bestOffsetNear(p.offset, 1);
+    refined[n] = p;
+  }
+  std::stable_sort(refined.begin(), refined.end(),
+                   [](const DensePose& a, const DensePose& b) { return a.telling_inliers > b.telling_inliers; });
+  for (const DensePose& p : refined)
+    if (std::none_of(out.poses.begin(), out.poses.end(), [&](const DensePose& q) { return isSame(p, q); }))
+      out.poses.push_back(p);
+  return out;
+}
+
+}  // namespace tomomap

@@ -1,0 +1,55 @@
+#pragma once
+// A dense search for small maps: every yaw, shift and height offset scored by
+// how much of the two maps' occupancy coincides, without features.
+#include <optional>
+#include <vector>
+
+#include "consensus.hpp"
+#include "rigid2d.hpp"
+#include "slices.hpp"
+
+namespace tomomap {
+
+struct DenseSearchParams {
+  /// The coarse raster has at most this many cells along each axis; the
+  /// coarse cell is a whole number of grid cells (at most kMaxCoarsening).
+  int coarse_side = 32;
+  double yaw_step = radians(3.0);    ///< [rad]; 3 deg moves a point 3 m out by 0.16 m, under one coarse cell
+  int candidates = 12;               ///< distinct coarse poses refined on the full grid
+  double inlier_radius_cells = 1.5;  ///< [grid cells]
+  int threads = 1;
+};
+
+/// A map is small enough for the dense search when its coarse cell need not be
+/// larger than this many grid cells: the search then stays under a second and
+/// its coarse cell under a wall's thickness plus a furniture's width.
+constexpr int kMaxCoarsening = 6;
+
+/// One pose the dense search found, refined on the full grid.
+struct DensePose {
+  Rigid2D transform;           ///< maps source x, y onto target x, y
+  int offset = 0;              ///< target slice index - source slice index
+  size_t inliers = 0;          ///< source cells that land within inlier_radius_cells of a target cell
+  size_t telling_inliers = 0;  ///< of those, the ones off walls, floors and ceilings (ranks the poses)
+  int support = 0;             ///< source slices with at least half their cells on target cells
+};
+
+struct DenseSearch {
+  /// False when the maps are too large for it (see kMaxCoarsening) or empty.
+  bool searched = false;
+  std::vector<DensePose> poses;  ///< distinct poses, most telling inliers first
+  size_t source_cells = 0;       ///< occupied cells of the source, the inliers' upper bound
+};
+
+/// Whether `stack` is small enough for searchDensely and holds every slice's cells.
+bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params = {});
+
+/// Correlates the maps' occupancy on a coarse raster at every yaw step, shift
+/// and height offset (FFT per slice pair), then refines the best distinct
+/// coarse poses on the full grid (refineOnOccupancy) and counts their inliers.
+/// Two poses are the same when `same` accepts them at `pivot` and their
+/// offsets are within one coarse cell.
+DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, const ConsensusParams& same,
+                          const Eigen::Vector2d& pivot, const DenseSearchParams& params = {});
+
+}  // namespace tomomap
