@@ -23,25 +23,33 @@ struct Cell {
 
 /// A room's walls, floor and ceiling fit it turned by a half or a quarter turn
 /// as well as the right way; what tells the turns apart is everything else.
-/// So a cell is "telling" unless its column is occupied in most slices (a
-/// wall) or its slice is mostly occupied (a floor or a ceiling).
-std::vector<Cell> cellsOf(const SliceStack& s) {
+/// So a cell is "telling" unless its column (with its neighbours within
+/// `wall_spread`) is occupied in most slices (a wall) or its slice is mostly
+/// occupied (a floor or a ceiling).
+std::vector<Cell> cellsOf(const SliceStack& s, double wall_spread) {
   const auto w = static_cast<uint32_t>(s.grid.width);
-  std::vector<uint16_t> column(static_cast<size_t>(s.grid.width) * static_cast<size_t>(s.grid.height), 0);
+  const int reach = static_cast<int>(std::floor(wall_spread / s.grid.cell + 1e-6));
+  const cv::Mat near = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * reach + 1, 2 * reach + 1));
+  cv::Mat column = cv::Mat::zeros(s.grid.height, s.grid.width, CV_16U), occupied;
   int occupied_slices = 0;
   size_t largest = 0;
-  for (const auto& cells : s.cells) {
-    occupied_slices += !cells.empty();
+  for (int k = 0; k < s.size(); ++k) {
+    const auto& cells = s.cells[static_cast<size_t>(k)];
+    if (cells.empty()) continue;
+    ++occupied_slices;
     largest = std::max(largest, cells.size());
-    for (uint32_t idx : cells) ++column[idx];
+    cv::dilate(s.image(k), occupied, near);
+    cv::add(column, occupied / 255, column, cv::noArray(), CV_16U);
   }
   std::vector<Cell> out;
   for (int k = 0; k < s.size(); ++k) {
     const auto& cells = s.cells[static_cast<size_t>(k)];
     const bool flat = cells.size() * 2 > largest;
-    for (uint32_t idx : cells)
-      out.push_back({s.grid.toMetres(static_cast<float>(idx % w), static_cast<float>(idx / w)).cast<double>(), k,
-                     !flat && column[idx] * 2 < occupied_slices});
+    for (uint32_t idx : cells) {
+      const int u = static_cast<int>(idx % w), v = static_cast<int>(idx / w);
+      out.push_back({s.grid.toMetres(static_cast<float>(u), static_cast<float>(v)).cast<double>(), k,
+                     !flat && column.at<uint16_t>(v, u) * 2 < occupied_slices});
+    }
   }
   return out;
 }
@@ -110,7 +118,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
                           const Eigen::Vector2d& pivot, const DenseSearchParams& params) {
   DenseSearch out;
   if (!denseSearchable(target, params) || !denseSearchable(source, params)) return out;
-  const std::vector<Cell> source_cells = cellsOf(source);
+  const std::vector<Cell> source_cells = cellsOf(source, params.wall_spread);
   if (source_cells.empty()) return out;
   out.searched = true;
   out.source_cells = source_cells.size();
@@ -199,12 +207,17 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   }
 
   // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
-  std::vector<cv::Mat> dilated(static_cast<size_t>(target.size()));
   const int r = static_cast<int>(std::floor(params.inlier_radius_cells));
   const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
-  for (int k = 0; k < target.size(); ++k)
-    if (!target.cells[static_cast<size_t>(k)].empty())
-      cv::dilate(target.image(k), dilated[static_cast<size_t>(k)], disk);
+  const auto dilatedSlices = [&](const SliceStack& stack) {
+    std::vector<cv::Mat> images(static_cast<size_t>(stack.size()));
+    for (int k = 0; k < stack.size(); ++k)
+      if (!stack.cells[static_cast<size_t>(k)].empty())
+        cv::dilate(stack.image(k), images[static_cast<size_t>(k)], disk);
+    return images;
+  };
+  const std::vector<cv::Mat> dilated = dilatedSlices(target), source_dilated = dilatedSlices(source);
+  const std::vector<Cell> target_cells = cellsOf(target, params.wall_spread);
   std::vector<DensePose> refined(coarse.size());
 #pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
   for (size_t n = 0; n < coarse.size(); ++n) {
@@ -218,6 +231,8 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
     bestOffsetNear(p.offset, c - 1);
     p.transform = refineOnOccupancy(target, source, p.offset, p.transform).transform;
     bestOffsetNear(p.offset, 1);
+    const Rigid2D inverse{-p.transform.yaw, -Rigid2D{-p.transform.yaw, Eigen::Vector2d::Zero()}.apply(p.transform.t)};
+    p.telling_inliers += countInliers(source_dilated, sg, target_cells, -p.offset, inverse, target.size()).telling;
     refined[n] = p;
   }
   std::stable_sort(refined.begin(), refined.end(),

@@ -17,6 +17,9 @@ struct DenseSearchParams {
   double yaw_step = radians(3.0);    ///< [rad]; 3 deg moves a point 3 m out by 0.16 m, under one coarse cell
   int candidates = 12;               ///< distinct coarse poses refined on the full grid
   double inlier_radius_cells = 1.5;  ///< [grid cells]
+  /// How far a scanned wall wanders from slice to slice (range noise either
+  /// side) [m]: a wall's column is counted with its neighbours this far.
+  double wall_spread = 0.05;
   int threads = 1;
 };
 
@@ -27,11 +30,14 @@ constexpr int kMaxCoarsening = 6;
 
 /// One pose the dense search found, refined on the full grid.
 struct DensePose {
-  Rigid2D transform;           ///< maps source x, y onto target x, y
-  int offset = 0;              ///< target slice index - source slice index
-  size_t inliers = 0;          ///< source cells that land within inlier_radius_cells of a target cell
-  size_t telling_inliers = 0;  ///< of those, the ones off walls, floors and ceilings (ranks the poses)
-  int support = 0;             ///< source slices with at least half their cells on target cells
+  Rigid2D transform;   ///< maps source x, y onto target x, y
+  int offset = 0;      ///< target slice index - source slice index
+  size_t inliers = 0;  ///< source cells that land within inlier_radius_cells of a target cell
+  /// Telling cells (off walls, floors and ceilings) of either map that land on
+  /// the other: what ranks the poses. Both ways, so that neither map's own
+  /// clutter decides alone.
+  size_t telling_inliers = 0;
+  int support = 0;  ///< source slices with at least half their cells on target cells
 };
 
 struct DenseSearch {
