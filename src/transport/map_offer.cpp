@@ -7,6 +7,7 @@
 #include <cstring>
 #include <set>
 
+#include "core/dense_search.hpp"
 #include "slice_encoding.hpp"
 
 namespace tomomap::transport {
@@ -29,13 +30,13 @@ std::vector<std::vector<T>> split(const std::vector<T>& items, size_t per_part) 
   return parts;
 }
 
-/// One slice's samples, in the cheaper encoding.
+/// One slice's samples, in the cheaper encoding, or as occupancy whenever it has cells if `cells_first`.
 std::vector<wire::SliceFeatures> cutSlice(const std::string& agent, const SliceFeatures& s,
                                           const std::vector<uint32_t>& cells, const SliceGrid& g,
-                                          size_t features_per_part, size_t bytes_per_part) {
+                                          size_t features_per_part, size_t bytes_per_part, bool cells_first) {
   std::vector<wire::Feature> feats = featuresToWire(s, g);
   const std::vector<uint8_t> deflated = cells.empty() ? std::vector<uint8_t>{} : deflateCells(cells, g.width, g.height);
-  const bool as_cells = !deflated.empty() && deflated.size() < feats.size() * kFeatureBytes;
+  const bool as_cells = !deflated.empty() && (cells_first || deflated.size() < feats.size() * kFeatureBytes);
   std::vector<wire::SliceFeatures> samples;
   auto base = [&](size_t part, size_t parts) {
     wire::SliceFeatures x;
@@ -92,9 +93,13 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const Feature
   });
   if (order.size() > wire::MAX_SLICES) order.resize(wire::MAX_SLICES);
 
+  // A map small enough for the dense search travels as occupancy throughout,
+  // so that the receiver can search it too (it rebuilds the same features
+  // from the cells); such maps are a few kilobytes either way.
+  const bool cells_first = denseSearchable(f.occupancy);
   for (const SliceFeatures* s : order) {
-    auto samples =
-        cutSlice(agent, *s, f.occupancy.cells.at(static_cast<size_t>(s->index)), g, features_per_part, bytes_per_part);
+    auto samples = cutSlice(agent, *s, f.occupancy.cells.at(static_cast<size_t>(s->index)), g, features_per_part,
+                            bytes_per_part, cells_first);
     const auto bytes = canonicalBytes(samples);
     wire::SliceEntry e;
     e.slice(s->index);

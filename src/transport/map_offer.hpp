@@ -19,7 +19,8 @@ struct MapOffer {
 
 /// Slices `features` (its occupancy must be present; `params` are the ones it
 /// was extracted with) into samples of at most `max_sample_bytes` each. Each
-/// slice travels as features or as deflated occupancy, whichever is smaller.
+/// slice travels as features or as deflated occupancy, whichever is smaller;
+/// every slice as occupancy when the map is small enough for the dense search.
 /// `raw_bytes` is the binary PCD size of the voxel-filtered map, announced for
 /// the record. Most informative slices (most features) first.
 MapOffer makeOffer(const std::string& agent, const MapFeatures& features, const FeatureParams& params,
