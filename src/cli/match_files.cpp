@@ -1,6 +1,7 @@
 #include "match_files.hpp"
 
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <iostream>
 
 #include "core/map_bounds.hpp"
@@ -24,7 +25,9 @@ MatchedFiles matchFiles(MatchFilesOptions o) {
   auto describe = [&](const std::string& path, const char* role) {
     size_t nonfinite = 0;
     std::string note;
+    const auto t0 = std::chrono::steady_clock::now();
     const Points map = loadMap(path, &nonfinite, &note);
+    timings.load += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!note.empty()) std::cerr << "note: " << note << "\n";
     m.inputs[role] = path;
     m.inputs[std::string(role) + "_points"] = map.size();

@@ -74,9 +74,9 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
                   r.target_slices, r.target_features, r.source_slices, r.source_features, r.slice_pairs);
     const auto& t = r.timings;
     out << format(
-        "time             %.3f s: voxel %.3f, slicing %.3f, features %.3f, pair matching %.3f, "
+        "time             %.3f s: load %.3f, voxel %.3f, slicing %.3f, features %.3f, pair matching %.3f, "
         "consensus %.3f, refinement %.3f, dense search %.3f\n",
-        t.total(), t.voxel, t.slicing, t.features, t.pair_matching, t.consensus, t.refinement, t.dense);
+        t.total(), t.load, t.voxel, t.slicing, t.features, t.pair_matching, t.consensus, t.refinement, t.dense);
   }
   if (gt) {
     const auto& e = gt->expected;
@@ -112,10 +112,15 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
                  {"target_features", r.target_features},
                  {"source_features", r.source_features}};
   const auto& t = r.timings;
-  j["timings_s"] = {{"voxel", t.voxel},         {"slicing", t.slicing},
-                    {"features", t.features},   {"pair_matching", t.pair_matching},
-                    {"consensus", t.consensus}, {"refinement", t.refinement},
-                    {"dense", t.dense},         {"total", t.total()}};
+  j["timings_s"] = {{"load", t.load},
+                    {"voxel", t.voxel},
+                    {"slicing", t.slicing},
+                    {"features", t.features},
+                    {"pair_matching", t.pair_matching},
+                    {"consensus", t.consensus},
+                    {"refinement", t.refinement},
+                    {"dense", t.dense},
+                    {"total", t.total()}};
   if (gt) {
     j["ground_truth"] = tomomap::toJson(gt->expected);
     if (r.reliable)

@@ -11,10 +11,12 @@ namespace tomomap {
 
 /// Wall-clock seconds per stage.
 struct StageTimings {
+  double load = 0;  ///< reading the map files (filled where they are read)
   double voxel = 0, slicing = 0, features = 0, pair_matching = 0, consensus = 0, refinement = 0, dense = 0;
-  double total() const { return voxel + slicing + features + pair_matching + consensus + refinement + dense; }
-  /// Takes the map-description stages (as describeMap fills them) from `d`.
+  double total() const { return load + voxel + slicing + features + pair_matching + consensus + refinement + dense; }
+  /// Takes the map-description stages (as describeMap fills them) and the load time from `d`.
   void takeDescription(const StageTimings& d) {
+    load = d.load;
     voxel = d.voxel;
     slicing = d.slicing;
     features = d.features;

@@ -69,7 +69,8 @@ Points fromBlob(const pcl::PCLPointCloud2& blob, const std::string& path) {
 
 Points loadPcl(const std::string& path, bool ply) {
   silencePcl();
-  if (!ply) checkPcdIntegrity(path);
+  if (!ply)
+    if (std::optional<Points> read = checkAndReadPcd(path)) return std::move(*read);
   pcl::PCLPointCloud2 blob;
   const int rc = ply ? pcl::io::loadPLYFile(path, blob) : pcl::io::loadPCDFile(path, blob);
   if (rc < 0) throw InputError(path + ": not a readable " + (ply ? "PLY" : "PCD") + " file (corrupt or truncated)");
