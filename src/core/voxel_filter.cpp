@@ -4,35 +4,61 @@
 #include <cstdint>
 
 namespace tomomap {
+namespace {
 
-Points voxelFilter(const Points& in, double leaf) {
-  if (in.empty()) return {};
-  if (!(leaf > 0.0)) throw InputError("voxel leaf size must be positive");
-  Eigen::Vector3f lo = in.front();
-  for (const auto& p : in) lo = lo.cwiseMin(p);
-
-  // Pack three 21-bit cell indices into one key: 2^21 cells per axis is 100 km at 0.05 m.
-  constexpr int64_t kBits = 21, kMax = (int64_t{1} << kBits) - 1;
-  std::vector<std::pair<uint64_t, uint32_t>> keyed;
-  keyed.reserve(in.size());
-  for (uint32_t i = 0; i < in.size(); ++i) {
-    const Eigen::Vector3f d = (in[i] - lo) / static_cast<float>(leaf);
-    const int64_t ix = std::min<int64_t>(static_cast<int64_t>(d.x()), kMax);
-    const int64_t iy = std::min<int64_t>(static_cast<int64_t>(d.y()), kMax);
-    const int64_t iz = std::min<int64_t>(static_cast<int64_t>(d.z()), kMax);
-    keyed.emplace_back(static_cast<uint64_t>((iz << (2 * kBits)) | (iy << kBits) | ix), i);
-  }
-  std::sort(keyed.begin(), keyed.end());
-
+/// The centroid of every run of equal cells in `sorted`, which holds (cell,
+/// point) in cell order; `cell` and `point` unpack an entry.
+template <typename Entry, typename CellOf, typename PointOf>
+Points centroids(const Points& in, const std::vector<Entry>& sorted, CellOf cell, PointOf point) {
   Points out;
-  for (size_t b = 0; b < keyed.size();) {
+  for (size_t b = 0; b < sorted.size();) {
     size_t e = b;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (; e < keyed.size() && keyed[e].first == keyed[b].first; ++e) sum += in[keyed[e].second].cast<double>();
+    for (; e < sorted.size() && cell(sorted[e]) == cell(sorted[b]); ++e) {
+      const Eigen::Vector3f& p = in[point(sorted[e])];
+      sum += p.cast<double>();
+    }
     out.push_back((sum / static_cast<double>(e - b)).cast<float>());
     b = e;
   }
   return out;
+}
+
+}  // namespace
+
+Points voxelFilter(const Points& in, double leaf) {
+  if (in.empty()) return {};
+  if (!(leaf > 0.0)) throw InputError("voxel leaf size must be positive");
+  Eigen::Vector3f lo = in.front(), hi = in.front();
+  for (const auto& p : in) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+
+  // Cell indices per axis, capped at 2^21 (100 km at 0.05 m) so that a packed
+  // cell fits 64 bits whatever the extent; packed as (z * ny + y) * nx + x, so
+  // that cell order is z, then y, then x.
+  constexpr int64_t kMax = (int64_t{1} << 21) - 1;
+  const auto index = [&](float d) {
+    return static_cast<uint64_t>(std::min<int64_t>(static_cast<int64_t>(d / static_cast<float>(leaf)), kMax));
+  };
+  const uint64_t nx = index(hi.x() - lo.x()) + 1, ny = index(hi.y() - lo.y()) + 1, nz = index(hi.z() - lo.z()) + 1;
+  const auto cellOf = [&](const Eigen::Vector3f& p) {
+    const Eigen::Vector3f d = p - lo;
+    return (index(d.z()) * ny + index(d.y())) * nx + index(d.x());
+  };
+
+  // Most maps have under 2^32 cells: cell and point then share one 64-bit
+  // word, and sorting plain words is twice as fast as sorting pairs.
+  if (nx * ny * nz <= (uint64_t{1} << 32) && in.size() <= (uint64_t{1} << 32)) {
+    std::vector<uint64_t> packed(in.size());
+    for (uint32_t i = 0; i < in.size(); ++i) packed[i] = cellOf(in[i]) << 32 | i;
+    std::sort(packed.begin(), packed.end());
+    return centroids(
+        in, packed, [](uint64_t v) { return v >> 32; }, [](uint64_t v) { return v & 0xFFFFFFFFu; });
+  }
+  std::vector<std::pair<uint64_t, uint32_t>> keyed(in.size());
+  for (uint32_t i = 0; i < in.size(); ++i) keyed[i] = {cellOf(in[i]), i};
+  std::sort(keyed.begin(), keyed.end());
+  return centroids(
+      in, keyed, [](const auto& k) { return k.first; }, [](const auto& k) { return k.second; });
 }
 
 }  // namespace tomomap
