@@ -43,6 +43,40 @@ TEST(MapIo, RoundTripsBinaryCompressedPcd) {
   EXPECT_EQ(q[123], p[123]);
 }
 
+// Binary PCDs are read by the integrity check's own pass (pcd_check.hpp):
+// x, y and z must come out of any record layout, floats or doubles.
+TEST(MapIo, BinaryPcdsWithOtherFieldsOrDoublesReadTheirXyz) {
+  TempDir dir;
+  const Points p = grid(300);
+  const auto header = [](const std::string& fields, const std::string& sizes, const std::string& types) {
+    return "# .PCD v0.7\nVERSION 0.7\nFIELDS " + fields + "\nSIZE " + sizes + "\nTYPE " + types +
+           "\nCOUNT 1 1 1 1\nWIDTH 300\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 300\nDATA binary\n";
+  };
+  {  // intensity first, then z, x, y: offsets from the header, not the field names' usual order
+    std::ofstream out(dir / "i.pcd", std::ios::binary);
+    out << header("intensity z x y", "4 4 4 4", "F F F F");
+    for (const auto& q : p) {
+      const float record[4] = {7.f, q.z(), q.x(), q.y()};
+      out.write(reinterpret_cast<const char*>(record), sizeof record);
+    }
+  }
+  {  // doubles, with a 1-byte label between y and z
+    std::ofstream out(dir / "d.pcd", std::ios::binary);
+    out << header("x y label z", "8 8 1 8", "F F U F");
+    for (const auto& q : p) {
+      const double x = q.x(), y = q.y(), z = q.z();
+      const char label = 3;
+      out.write(reinterpret_cast<const char*>(&x), 8).write(reinterpret_cast<const char*>(&y), 8);
+      out.write(&label, 1).write(reinterpret_cast<const char*>(&z), 8);
+    }
+  }
+  for (const char* f : {"i.pcd", "d.pcd"}) {
+    const Points q = loadMap(dir / f);
+    ASSERT_EQ(q.size(), p.size()) << f;
+    for (size_t k : {size_t{0}, size_t{123}, size_t{299}}) EXPECT_EQ(q[k], p[k]) << f << " point " << k;
+  }
+}
+
 TEST(MapIo, ReadsAsciiPcdPlyAndXyz) {
   TempDir dir;
   std::string pcd = pcdHeader(200, "ascii"), ply, xyz = "# x y z\n";
