@@ -30,10 +30,7 @@ std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& 
       continue;
     PairCells p{target.image(i), {}};
     const auto& cells = source.cells[static_cast<size_t>(j)];
-    for (size_t k = 0; k < cells.size(); k += stride)
-      p.source.push_back(g.toMetres(static_cast<float>(cells[k] % static_cast<uint32_t>(g.width)),
-                                    static_cast<float>(cells[k] / static_cast<uint32_t>(g.width)))
-                             .cast<double>());
+    for (size_t k = 0; k < cells.size(); k += stride) p.source.push_back(g.cellCentre(cells[k]));
     pairs.push_back(std::move(p));
   }
   return pairs;

@@ -27,7 +27,6 @@ struct Cell {
 /// `wall_spread`) is occupied in most slices (a wall) or its slice is mostly
 /// occupied (a floor or a ceiling).
 std::vector<Cell> cellsOf(const SliceStack& s, double wall_spread) {
-  const auto w = static_cast<uint32_t>(s.grid.width);
   const int reach = static_cast<int>(std::floor(wall_spread / s.grid.cell + 1e-6));
   const cv::Mat near = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * reach + 1, 2 * reach + 1));
   cv::Mat column = cv::Mat::zeros(s.grid.height, s.grid.width, CV_16U), occupied;
@@ -45,34 +44,23 @@ std::vector<Cell> cellsOf(const SliceStack& s, double wall_spread) {
   for (int k = 0; k < s.size(); ++k) {
     const auto& cells = s.cells[static_cast<size_t>(k)];
     const bool flat = cells.size() * 2 > largest;
-    for (uint32_t idx : cells) {
-      const int u = static_cast<int>(idx % w), v = static_cast<int>(idx / w);
-      out.push_back({s.grid.toMetres(static_cast<float>(u), static_cast<float>(v)).cast<double>(), k,
-                     !flat && column.at<uint16_t>(v, u) * 2 < occupied_slices});
-    }
+    for (uint32_t idx : cells)  // the column image is continuous: cell index = element index
+      out.push_back({s.grid.cellCentre(idx), k, !flat && column.ptr<uint16_t>()[idx] * 2 < occupied_slices});
   }
   return out;
 }
 
-/// A stack of coarse binary images, transformed to the frequency domain
-/// (OpenCV's packed real spectra) at a common padded size.
-struct Spectra {
-  std::vector<cv::Mat> slices;  ///< empty Mat = no occupied cell in that coarse slice
-};
-
-Spectra transform(std::vector<cv::Mat>& images, cv::Size padded) {
-  Spectra s;
-  for (auto& img : images) {
-    if (cv::countNonZero(img) == 0) {
-      s.slices.emplace_back();
-      continue;
-    }
-    cv::Mat big = cv::Mat::zeros(padded, CV_32F), spectrum;
-    img.copyTo(big(cv::Rect(0, 0, img.cols, img.rows)));
-    cv::dft(big, spectrum);
-    s.slices.push_back(spectrum);
+/// A stack of coarse binary images in the frequency domain (OpenCV's packed
+/// real spectra) at a common padded size; an empty Mat for an empty image.
+std::vector<cv::Mat> spectra(const std::vector<cv::Mat>& images, cv::Size padded) {
+  std::vector<cv::Mat> out(images.size());
+  for (size_t k = 0; k < images.size(); ++k) {
+    if (cv::countNonZero(images[k]) == 0) continue;
+    cv::Mat big = cv::Mat::zeros(padded, CV_32F);
+    images[k].copyTo(big(cv::Rect(0, 0, images[k].cols, images[k].rows)));
+    cv::dft(big, out[k]);
   }
-  return s;
+  return out;
 }
 
 /// The best shift at one (yaw, coarse height offset).
@@ -121,7 +109,6 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   const std::vector<Cell> source_cells = cellsOf(source, params.wall_spread);
   if (source_cells.empty()) return out;
   out.searched = true;
-  out.source_cells = source_cells.size();
 
   const SliceGrid& tg = target.grid;
   const SliceGrid& sg = source.grid;
@@ -143,7 +130,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   for (int k = 0; k < target.size(); ++k)
     for (uint32_t idx : target.cells[static_cast<size_t>(k)])
       timg[static_cast<size_t>(k / c)].at<float>(static_cast<int>(idx / tw) / c, static_cast<int>(idx % tw) / c) = 1.f;
-  const Spectra tspec = transform(timg, padded);
+  const std::vector<cv::Mat> tspec = spectra(timg, padded);
 
   const int steps = std::max(1, static_cast<int>(std::lround(2.0 * kPi / params.yaw_step)));
   std::vector<std::vector<Peak>> peaks(static_cast<size_t>(steps));
@@ -158,13 +145,13 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
       const int v = static_cast<int>((sn * d.x() + cs * d.y() + radius) / C);
       simg[static_cast<size_t>(cell.slice / c)].at<float>(v, u) = 1.f;
     }
-    const Spectra sspec = transform(simg, padded);
+    const std::vector<cv::Mat> sspec = spectra(simg, padded);
     cv::Mat acc, product, corr;
     for (int dz = -(zs - 1); dz <= zt - 1; ++dz) {
       bool any = false;
       for (int z = std::max(0, -dz); z < zs && z + dz < zt; ++z) {
-        const cv::Mat& a = tspec.slices[static_cast<size_t>(z + dz)];
-        const cv::Mat& b = sspec.slices[static_cast<size_t>(z)];
+        const cv::Mat& a = tspec[static_cast<size_t>(z + dz)];
+        const cv::Mat& b = sspec[static_cast<size_t>(z)];
         if (a.empty() || b.empty()) continue;
         cv::mulSpectrums(a, b, product, 0, true);
         if (any)
@@ -188,8 +175,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   const auto poseOf = [&](const Peak& k) {
     const double yaw = 2.0 * kPi * k.yaw_step / steps;
     Rigid2D T{yaw, Eigen::Vector2d::Zero()};
-    const Eigen::Vector2d turned_centre = Rigid2D{yaw, Eigen::Vector2d::Zero()}.apply(centre);
-    T.t = Eigen::Vector2d(tg.x_min + radius + k.dx * C, tg.y_min + radius + k.dy * C) - turned_centre;
+    T.t = Eigen::Vector2d(tg.x_min + radius + k.dx * C, tg.y_min + radius + k.dy * C) - T.apply(centre);
     return DensePose{T, k.dz * c, 0};
   };
   const auto isSame = [&](const DensePose& a, const DensePose& b) {
@@ -231,8 +217,8 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
     bestOffsetNear(p.offset, c - 1);
     p.transform = refineOnOccupancy(target, source, p.offset, p.transform).transform;
     bestOffsetNear(p.offset, 1);
-    const Rigid2D inverse{-p.transform.yaw, -Rigid2D{-p.transform.yaw, Eigen::Vector2d::Zero()}.apply(p.transform.t)};
-    p.telling_inliers += countInliers(source_dilated, sg, target_cells, -p.offset, inverse, target.size()).telling;
+    p.telling_inliers +=
+        countInliers(source_dilated, sg, target_cells, -p.offset, p.transform.inverse(), target.size()).telling;
     refined[n] = p;
   }
   std::stable_sort(refined.begin(), refined.end(),

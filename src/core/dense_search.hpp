@@ -44,7 +44,6 @@ struct DenseSearch {
   /// False when the maps are too large for it (see kMaxCoarsening) or empty.
   bool searched = false;
   std::vector<DensePose> poses;  ///< distinct poses, most telling inliers first
-  size_t source_cells = 0;       ///< occupied cells of the source, the inliers' upper bound
 };
 
 /// Whether `stack` is small enough for searchDensely and holds every slice's cells.

@@ -15,6 +15,8 @@ struct Rigid2D {
     const double c = std::cos(yaw), s = std::sin(yaw);
     return {c * p.x() - s * p.y() + t.x(), s * p.x() + c * p.y() + t.y()};
   }
+  /// Maps target onto source.
+  Rigid2D inverse() const { return {-yaw, -Rigid2D{-yaw, Eigen::Vector2d::Zero()}.apply(t)}; }
 };
 
 struct Correspondences {

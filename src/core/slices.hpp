@@ -21,6 +21,11 @@ struct SliceGrid {
   Eigen::Vector2f toMetres(float u, float v) const {
     return {static_cast<float>(x_min + (u + 0.5) * cell), static_cast<float>(y_min + (v + 0.5) * cell)};
   }
+  /// Centre [m] of the cell stored as `index` (v * width + u) in SliceStack::cells.
+  Eigen::Vector2d cellCentre(uint32_t index) const {
+    const auto w = static_cast<uint32_t>(width);
+    return toMetres(static_cast<float>(index % w), static_cast<float>(index / w)).cast<double>();
+  }
   /// The inverse: (sub)pixel position of map-frame x, y [m]; centres are integers.
   Eigen::Vector2d toPixel(double x, double y) const { return {(x - x_min) / cell - 0.5, (y - y_min) / cell - 0.5}; }
 };

@@ -19,12 +19,10 @@ std::vector<Eigen::Vector2d> verticalStructure(const SliceStack& s, int min_slic
   for (const auto& slice : s.cells) cells.insert(cells.end(), slice.begin(), slice.end());
   std::sort(cells.begin(), cells.end());
   std::vector<Eigen::Vector2d> xy;
-  const auto w = static_cast<uint32_t>(s.grid.width);
   for (size_t i = 0; i < cells.size();) {
     size_t j = i;
     while (j < cells.size() && cells[j] == cells[i]) ++j;
-    if (static_cast<int>(j - i) >= min_slices)
-      xy.push_back(s.grid.toMetres(static_cast<float>(cells[i] % w), static_cast<float>(cells[i] / w)).cast<double>());
+    if (static_cast<int>(j - i) >= min_slices) xy.push_back(s.grid.cellCentre(cells[i]));
     i = j;
   }
   return xy;

@@ -109,3 +109,11 @@ TEST(Rigid2D, RefinementStopsAsItsRuleSays) {
   EXPECT_GE(fine.inliers.size(), 130u);
   EXPECT_EQ(fine.inliers, collectInliers(c, fine.transform, 0.3)) << "inliers are those of the result";
 }
+
+TEST(Rigid2D, InverseUndoesTheTransform) {
+  const Rigid2D T{0.7, {1.5, -2.0}};
+  for (const Eigen::Vector2d& p : {Eigen::Vector2d(0, 0), Eigen::Vector2d(3, -4), Eigen::Vector2d(-1, 2)}) {
+    EXPECT_LT((T.inverse().apply(T.apply(p)) - p).norm(), 1e-12);
+    EXPECT_LT((T.apply(T.inverse().apply(p)) - p).norm(), 1e-12);
+  }
+}
