@@ -71,6 +71,9 @@ void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 90.0));
   sub.add_flag("--level", o.params.level, "level a tilted map (turn its up onto z) instead of refusing it");
+  sub.add_flag("--exhaustive", o.params.exhaustive,
+               "match every slice pair instead of the height offsets the descriptor index points to "
+               "(same answers, n^2 cost; for checking)");
   sub.add_flag("--progress", o.progress, "show progress even when stderr is not a terminal");
   sub.add_flag("-q,--quiet", o.quiet, "print only the result, one line");
 }

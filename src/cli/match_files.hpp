@@ -29,7 +29,7 @@ struct MatchedFiles {
 /// which halves peak memory on large maps), then matches.
 MatchedFiles matchFiles(MatchFilesOptions o);
 
-/// Adds --grid, --json, --gt-target, --gt-source, --features, -j, --max-tilt, --level, --progress, -q.
+/// Adds --grid, --json, --gt-target, --gt-source, --features, -j, --max-tilt, --level, --exhaustive, --progress, -q.
 void addMatchOptions(CLI::App& sub, MatchFilesOptions& o);
 
 }  // namespace tomomap::cli

@@ -70,8 +70,9 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
                     r.method == "dense" ? "found this answer (the features found none)" : "ran beside the features",
                     r.dense_lead);
     out << "tilt             target " << tiltText(r.target_tilt) << ", source " << tiltText(r.source_tilt) << "\n";
-    out << format("slices           target %d (%zu features), source %d (%zu features), %zu slice pairs\n",
-                  r.target_slices, r.target_features, r.source_slices, r.source_features, r.slice_pairs);
+    out << format(
+        "slices           target %d (%zu features), source %d (%zu features), %zu of %zu slice pairs matched\n",
+        r.target_slices, r.target_features, r.source_slices, r.source_features, r.slice_pairs, r.slice_pairs_total);
     const auto& t = r.timings;
     out << format(
         "time             %.3f s: load %.3f, voxel %.3f, slicing %.3f, features %.3f, pair matching %.3f, "
@@ -109,6 +110,7 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
   j["slices"] = {{"target", r.target_slices},
                  {"source", r.source_slices},
                  {"pairs", r.slice_pairs},
+                 {"pairs_total", r.slice_pairs_total},
                  {"target_features", r.target_features},
                  {"source_features", r.source_features}};
   const auto& t = r.timings;

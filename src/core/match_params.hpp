@@ -19,6 +19,9 @@ struct MatchParams {
   int min_support = 3;                       ///< agreeing slice pairs needed for a reliable match
   int min_inliers = 20;                      ///< inlier correspondences needed for a reliable match
   int threads = 0;                           ///< threads one match uses; 0 = every core
+  /// Match every slice pair instead of those at the height offsets a descriptor
+  /// index votes for (offset_search.hpp): the same answers, at n^2 cost.
+  bool exhaustive = false;
   /// A map whose z axis is farther than this from gravity is refused: its
   /// slices cut walls at a slant (see docs/results.md for where 2 degrees comes from).
   double max_tilt = radians(2.0);  ///< [rad]

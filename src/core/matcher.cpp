@@ -7,6 +7,7 @@
 #include "dense_search.hpp"
 #include "height_offsets.hpp"
 #include "map_check.hpp"
+#include "offset_search.hpp"
 #include "refine.hpp"
 #include "text.hpp"
 #include "voxel_filter.hpp"
@@ -192,8 +193,9 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   }
 
   auto t0 = Clock::now();
-  const SlicePairTable pairs = estimateSlicePairs(target, source, params, progress);
-  r.slice_pairs = nt * ns;
+  const SlicePairTable pairs = matchSlicePairs(target, source, params, progress);
+  r.slice_pairs = pairs.matchedCount();
+  r.slice_pairs_total = nt * ns;
   r.timings.pair_matching = secondsSince(t0);
 
   t0 = Clock::now();

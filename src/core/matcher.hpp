@@ -59,7 +59,8 @@ struct MatchResult {
 
   int target_slices = 0, source_slices = 0;
   size_t target_features = 0, source_features = 0;
-  size_t slice_pairs = 0;  ///< slice pairs matched (n_target x n_source with features)
+  size_t slice_pairs = 0;        ///< slice pairs matched (all, or those the offset votes point to)
+  size_t slice_pairs_total = 0;  ///< n_target x n_source slices with features
   StageTimings timings;
 };
 

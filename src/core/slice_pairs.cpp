@@ -45,36 +45,52 @@ Correspondences correspondencesOf(const SlicePairTable& table, const MapFeatures
   return positions(target.slices[a], source.slices[b], table.matches[table.index(a, b)]);
 }
 
-SlicePairTable estimateSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
-                                  const Progress& progress) {
-  SlicePairTable table;
-  table.nt = target.slices.size();
-  table.ns = source.slices.size();
-  const size_t n = table.nt * table.ns;
-  table.estimates.resize(n);
-  table.matches.resize(n);
+size_t SlicePairTable::matchedCount() const {
+  return static_cast<size_t>(std::count(matched.begin(), matched.end(), uint8_t{1}));
+}
+
+void estimateSlicePairs(SlicePairTable& table, const std::vector<size_t>& pairs, const MapFeatures& target,
+                        const MapFeatures& source, const MatchParams& params, const Progress& progress) {
+  std::vector<size_t> todo;  // each pair once, even if listed twice
+  std::vector<uint8_t> listed(table.matched);
+  for (size_t k : pairs)
+    if (!listed[k]) {
+      listed[k] = 1;
+      todo.push_back(k);
+    }
+  const size_t n = todo.size();
   const RansacParams ransac = ransacParams(params);
   std::atomic<size_t> done{0};
   const size_t report_every = std::max<size_t>(1, n / 100);
 #pragma omp parallel for schedule(dynamic, 4) num_threads(matchThreads(params))
-  for (long long k = 0; k < static_cast<long long>(n); ++k) {
-    const size_t a = static_cast<size_t>(k) / table.ns, b = static_cast<size_t>(k) % table.ns;
+  for (long long i = 0; i < static_cast<long long>(n); ++i) {
+    const size_t k = todo[static_cast<size_t>(i)];
+    const size_t a = k / table.ns, b = k % table.ns;
     const auto matches = mutualNearest(source.slices[b].descriptors, target.slices[a].descriptors);
-    auto& kept = table.matches[static_cast<size_t>(k)];
+    auto& kept = table.matches[k];
     kept.reserve(matches.size());
     for (const auto& [s, t] : matches) kept.emplace_back(static_cast<uint16_t>(s), static_cast<uint16_t>(t));
     if (matches.size() >= static_cast<size_t>(params.min_matches)) {
       const Correspondences c = positions(target.slices[a], source.slices[b], matches);
       // Seeded per pair so results do not depend on thread scheduling.
       if (auto est = ransacRigid2D(c, ransac, 0x9E3779B97F4A7C15ull * (a + 1) + b))
-        table.estimates[static_cast<size_t>(k)] = {true, est->transform, static_cast<uint32_t>(est->inliers.size())};
+        table.estimates[k] = {true, est->transform, static_cast<uint32_t>(est->inliers.size())};
     }
+    table.matched[k] = 1;
     const size_t finished = ++done;
     if (progress && finished % report_every == 0) {
 #pragma omp critical(tomomap_progress)
       progress("slice pairs", finished, n);
     }
   }
+}
+
+SlicePairTable estimateSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
+                                  const Progress& progress) {
+  SlicePairTable table(target.slices.size(), source.slices.size());
+  std::vector<size_t> all(table.estimates.size());
+  for (size_t k = 0; k < all.size(); ++k) all[k] = k;
+  estimateSlicePairs(table, all, target, source, params, progress);
   return table;
 }
 

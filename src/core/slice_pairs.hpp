@@ -17,25 +17,37 @@ struct PairEstimate {
   uint32_t inliers = 0;
 };
 
-/// Every slice pair of two maps, row-major (target slice a, source slice b at
-/// a * ns + b). The mutual matches are kept, as compact index pairs (source
-/// feature, target feature), so that refinement reuses them instead of
-/// matching the winning offset's slices again.
+/// The slice pairs of two maps, row-major (target slice a, source slice b at
+/// a * ns + b), of which those `matched` hold their outcome (every pair, or
+/// only those at the height offsets worth matching: offset_search.hpp). The
+/// mutual matches are kept, as compact index pairs (source feature, target
+/// feature), so that refinement reuses them instead of matching the winning
+/// offset's slices again.
 struct SlicePairTable {
   size_t nt = 0, ns = 0;
   std::vector<PairEstimate> estimates;
   std::vector<std::vector<std::pair<uint16_t, uint16_t>>> matches;
+  std::vector<uint8_t> matched;  ///< 1 where the pair has been matched
 
+  SlicePairTable() = default;
+  SlicePairTable(size_t n_target, size_t n_source)
+      : nt(n_target), ns(n_source), estimates(nt * ns), matches(nt * ns), matched(nt * ns, 0) {}
   size_t index(size_t a, size_t b) const { return a * ns + b; }
+  size_t matchedCount() const;
 };
 
 /// Mutual nearest neighbours in Hamming distance between two slices' descriptors,
 /// as matched map-frame positions (source -> target).
 Correspondences matchSlices(const SliceFeatures& target, const SliceFeatures& source);
 
-/// Matches and estimates every slice pair, in parallel on matchThreads(params)
-/// threads. Each pair's RANSAC is seeded from its indices, so the result does
-/// not depend on scheduling.
+/// Matches and estimates the pairs `pairs` (table indices) that are not matched
+/// yet, in parallel on matchThreads(params) threads. Each pair's RANSAC is
+/// seeded from its indices, so the result depends neither on scheduling nor
+/// on which other pairs were matched.
+void estimateSlicePairs(SlicePairTable& table, const std::vector<size_t>& pairs, const MapFeatures& target,
+                        const MapFeatures& source, const MatchParams& params, const Progress& progress);
+
+/// Every slice pair matched and estimated.
 SlicePairTable estimateSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
                                   const Progress& progress);
 

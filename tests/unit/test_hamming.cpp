@@ -2,6 +2,7 @@
 
 #include <opencv2/core.hpp>
 #include <random>
+#include <tuple>
 
 #include "core/hamming.hpp"
 
@@ -37,4 +38,19 @@ TEST(Hamming, EmptySetsGiveNoMatches) {
   cv::Mat a(5, 32, CV_8U, cv::Scalar(1));
   EXPECT_TRUE(mutualNearest(a, cv::Mat()).empty());
   EXPECT_TRUE(mutualNearest(cv::Mat(), a).empty());
+}
+
+TEST(Hamming, TheVectorKernelGivesTheScalarKernelsMatchesTiesIncluded) {
+  if (!vectorHammingAvailable()) GTEST_SKIP() << "this CPU has no AVX-512 VPOPCNTDQ: only the scalar kernel runs";
+  cv::RNG rng(11);
+  // Few distinct bytes make many equal distances, so the tie rules are exercised;
+  // sizes that are not multiples of 8 exercise the last, partial block.
+  for (const auto& [na, nb, values] : {std::tuple{1, 1, 256}, std::tuple{37, 13, 2}, std::tuple{64, 64, 3},
+                                       std::tuple{500, 999, 256}, std::tuple{9, 300, 4}}) {
+    cv::Mat a(na, 32, CV_8U), b(nb, 32, CV_8U);
+    rng.fill(a, cv::RNG::UNIFORM, 0, values);
+    rng.fill(b, cv::RNG::UNIFORM, 0, values);
+    EXPECT_EQ(mutualNearest(a, b, HammingKernel::Fastest), mutualNearest(a, b, HammingKernel::Scalar))
+        << na << " x " << nb << ", bytes below " << values;
+  }
 }

@@ -1,0 +1,127 @@
+#include "offset_search.hpp"
+
+#include <algorithm>
+
+#include "height_offsets.hpp"
+#include "offset_votes.hpp"
+
+namespace tomomap {
+namespace {
+
+/// Offsets matched either side of a vote peak and of the winner and runner-up:
+/// refinement uses the winner's neighbours, and a neighbour with more support
+/// must be seen to be climbed to.
+constexpr int kSearchMargin = 1;
+
+/// Vote peaks followed: the strongest few, down to half of the strongest. A
+/// second floor that fits as well as the first (the two-floor test) has as
+/// many votes; the true offset's neighbours, fewer than the true offset but
+/// no peaks of their own.
+constexpr double kPeakShare = 0.5;
+constexpr size_t kMaxPeaks = 4;
+
+/// Slice pairs sampled on every height offset: a safety net for maps whose
+/// descriptors do not tell heights apart (a street of uniform facades votes
+/// for every offset alike), where the true offset shows only in the slice
+/// pairs' geometric agreement.
+constexpr size_t kSamplesPerOffset = 8;
+
+/// An offset is matched in full once its sampled support, scaled to its whole
+/// diagonal, reaches this share of the best full support so far: a sample of
+/// 8 pairs misjudges an offset's support by up to about half (synth street
+/// and building, demo-room), and an answer with 1 / 1.25 of the winner's
+/// support already makes the match ambiguous (matcher.cpp).
+constexpr double kRivalShare = 0.5;
+
+/// Below this many times min_support, a winner is judged ambiguous by an
+/// absolute margin (another answer within min_support pairs of it,
+/// matcher.cpp), finer than a sample of a few pairs per offset can resolve:
+/// such weak winners are checked against every pair.
+constexpr int kSampledSupport = 5;
+
+/// The slice pairs on each height offset's diagonal (target slice index -
+/// source slice index), as table indices by increasing target slice.
+class Diagonals {
+ public:
+  Diagonals(const MapFeatures& target, const MapFeatures& source, const SlicePairTable& table)
+      : first_(target.slices.front().index - source.slices.back().index),
+        pairs_(static_cast<size_t>(target.slices.back().index - source.slices.front().index - first_ + 1)) {
+    for (size_t a = 0; a < table.nt; ++a)
+      for (size_t b = 0; b < table.ns; ++b)
+        at(target.slices[a].index - source.slices[b].index).push_back(table.index(a, b));
+  }
+  int first() const { return first_; }
+  int last() const { return first_ + static_cast<int>(pairs_.size()) - 1; }
+  const std::vector<size_t>& of(int offset) const {
+    static const std::vector<size_t> none;
+    return offset < first_ || offset > last() ? none : pairs_[static_cast<size_t>(offset - first_)];
+  }
+
+ private:
+  std::vector<size_t>& at(int offset) { return pairs_[static_cast<size_t>(offset - first_)]; }
+  int first_;
+  std::vector<std::vector<size_t>> pairs_;
+};
+
+/// Adds the pairs of `offset` and kSearchMargin offsets either side.
+void addAround(int offset, const Diagonals& d, std::vector<size_t>& out) {
+  for (int o = offset - kSearchMargin; o <= offset + kSearchMargin; ++o)
+    out.insert(out.end(), d.of(o).begin(), d.of(o).end());
+}
+
+/// Adds at most `count` pairs of every offset, spread evenly along its diagonal.
+void addSamples(const Diagonals& d, size_t count, std::vector<size_t>& out) {
+  for (int o = d.first(); o <= d.last(); ++o) {
+    const std::vector<size_t>& pairs = d.of(o);
+    const size_t take = std::min(count, pairs.size());
+    for (size_t i = 0; i < take; ++i) out.push_back(pairs[(2 * i + 1) * pairs.size() / (2 * take)]);
+  }
+}
+
+/// The pairs to match next, given what the matched ones say: none once the
+/// winner and the runner-up stand among matched neighbours and no sampled
+/// offset promises a rival.
+std::vector<size_t> nextPairs(const SlicePairTable& table, const Diagonals& diagonals, const MapFeatures& target,
+                              const MapFeatures& source, const MatchParams& params) {
+  std::vector<size_t> todo;
+  const std::vector<OffsetScore> scores = scoreOffsets(table, target, source, params);
+  const OffsetChoice choice = pickOffset(scores, params, source.centre());
+  const int best = choice.best ? static_cast<int>(choice.best->consensus.support()) : 0;
+  if (best < kSampledSupport * params.min_support) {
+    for (size_t k = 0; k < table.matched.size(); ++k)
+      if (!table.matched[k]) todo.push_back(k);
+    return todo;
+  }
+  addAround(choice.best->offset, diagonals, todo);
+  if (choice.runner_up_support > 0) addAround(choice.runner_up_offset, diagonals, todo);
+  for (const OffsetScore& s : scores) {
+    const std::vector<size_t>& pairs = diagonals.of(s.offset);
+    const auto matched =
+        static_cast<size_t>(std::count_if(pairs.begin(), pairs.end(), [&](size_t k) { return table.matched[k] != 0; }));
+    const double projected = static_cast<double>(s.consensus.support() * pairs.size()) / static_cast<double>(matched);
+    if (matched < pairs.size() && projected >= kRivalShare * best) todo.insert(todo.end(), pairs.begin(), pairs.end());
+  }
+  todo.erase(std::remove_if(todo.begin(), todo.end(), [&](size_t k) { return table.matched[k] != 0; }), todo.end());
+  return todo;
+}
+
+}  // namespace
+
+SlicePairTable matchSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
+                               const Progress& progress) {
+  if (params.exhaustive || target.slices.empty() || source.slices.empty())
+    return estimateSlicePairs(target, source, params, progress);
+  SlicePairTable table(target.slices.size(), source.slices.size());
+  const Diagonals diagonals(target, source, table);
+  std::vector<size_t> todo;
+  for (int peak : voteHeightOffsets(target, source, matchThreads(params)).peaks(kSmearSlices, kPeakShare, kMaxPeaks))
+    addAround(peak, diagonals, todo);
+  addSamples(diagonals, kSamplesPerOffset, todo);
+  while (!todo.empty()) {
+    estimateSlicePairs(table, todo, target, source, params, progress);
+    todo = nextPairs(table, diagonals, target, source, params);
+  }
+  return table;
+}
+
+}  // namespace tomomap

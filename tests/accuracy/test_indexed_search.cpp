@@ -1,0 +1,103 @@
+// The indexed search (offset_search.hpp) against the exhaustive one it
+// replaces: on every case the accuracy tests use, the same verdict, the same
+// winning height offset and the same transform, from a fraction of the pairs.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/matcher.hpp"
+#include "support.hpp"
+#include "synth/synth.hpp"
+
+using namespace tomomap;
+using namespace tomomap::synth;
+
+namespace {
+
+/// Pairs matched by both searches over the cases of one test.
+struct Tally {
+  size_t indexed = 0, exhaustive = 0, cases = 0;
+  ~Tally() {
+    if (cases)
+      std::cout << cases << " cases: the indexed search matched " << indexed << " of " << exhaustive << " slice pairs ("
+                << 100.0 * static_cast<double>(indexed) / static_cast<double>(exhaustive) << " %)\n";
+  }
+};
+
+void expectSameAnswer(const MapFeatures& target, const MapFeatures& source, MatchParams params, const std::string& what,
+                      Tally& tally) {
+  params.exhaustive = true;
+  const MatchResult all = matchFeatures(target, source, params);
+  params.exhaustive = false;
+  const MatchResult indexed = matchFeatures(target, source, params);
+  tally.indexed += indexed.slice_pairs;
+  tally.exhaustive += all.slice_pairs;
+  ++tally.cases;
+  ASSERT_EQ(indexed.reliable, all.reliable)
+      << what << ": indexed '" << indexed.reason << "', exhaustive '" << all.reason << "'";
+  EXPECT_EQ(indexed.method, all.method) << what;
+  if (!all.reliable) return;
+  if (indexed.height_offset != all.height_offset)
+    std::cout << what << ": indexed offset " << indexed.height_offset << " support " << indexed.support
+              << " (runner-up " << indexed.runner_up_support << " at " << indexed.runner_up_offset
+              << "), exhaustive offset " << all.height_offset << " support " << all.support << " (runner-up "
+              << all.runner_up_support << " at " << all.runner_up_offset << ")\n";
+  EXPECT_EQ(indexed.height_offset, all.height_offset) << what;
+  EXPECT_EQ(indexed.support, all.support) << what;
+  const PoseError e = poseError(indexed.T_target_source, all.T_target_source);
+  EXPECT_LT(e.translation, 0.001) << what;
+  EXPECT_LT(e.yaw, 0.0005) << what;
+}
+
+}  // namespace
+
+TEST(IndexedSearch, AnswersTheDemoRoomLikeTheExhaustiveSearchWhereverTheSourceIsMoved) {
+  REQUIRE_DEMO_ROOM();
+  const auto d = test::loadDemoPair();
+  const MatchParams p;
+  const MapFeatures f1 = describeMap(d.map1, p), f2 = describeMap(d.map2, p);
+  Tally tally;
+  expectSameAnswer(f1, f2, p, "pcd2 -> pcd1", tally);
+  expectSameAnswer(f2, f1, p, "pcd1 -> pcd2", tally);
+  // The moves of DemoRoom.SucceedsWhereverTheSourceIsMoved and its corners.
+  std::vector<Pose4> moves{
+      {50, 50, 3, kPi}, {-50, -50, -3, -kPi + 1e-6}, {50, -50, -3, kPi / 2}, {-50, 50, 3, -kPi / 2}};
+  std::mt19937 rng(2024);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 24; ++i) moves.push_back({50 * u(rng), 50 * u(rng), 3 * u(rng), kPi * u(rng)});
+  for (const Pose4& M : moves)
+    expectSameAnswer(f1, describeMap(transformPoints(d.map2, M), p), p,
+                     "move " + std::to_string(M.x) + " " + std::to_string(M.y) + " " + std::to_string(M.yaw), tally);
+}
+
+TEST(IndexedSearch, RefusesTwoIdenticalFloorsLikeTheExhaustiveSearch) {
+  REQUIRE_DEMO_ROOM();
+  const auto d = test::loadDemoPair();
+  Points two_floors = d.map1;
+  for (const auto& q : d.map1) two_floors.push_back(q + Eigen::Vector3f(0, 0, 4.0f));
+  const MatchParams p;
+  MatchParams indexed = p;
+  const MatchResult r = matchMaps(two_floors, d.map2, indexed);
+  EXPECT_FALSE(r.reliable);
+  EXPECT_NE(r.reason.find("ambiguous"), std::string::npos) << r.reason;
+  Tally tally;
+  expectSameAnswer(describeMap(two_floors, p), describeMap(d.map2, p), p, "two floors", tally);
+}
+
+TEST(IndexedSearch, AnswersGeneratedWorldsLikeTheExhaustiveSearch) {
+  Tally tally;
+  for (WorldType type : {WorldType::Indoor, WorldType::Outdoor, WorldType::Room})
+    for (const char* noise : {"none", "low", "high"})
+      for (uint64_t seed = 1; seed <= 10; ++seed) {
+        SceneParams sp;
+        sp.type = type;
+        sp.seed = seed;
+        sp.scale = type == WorldType::Room ? 1.0 : 0.5;
+        const Scene scene = makeScene(sp);
+        const auto maps = scanScene(scene, noiseLevel(noise), seed);
+        MatchParams p;
+        p.grid = type == WorldType::Room ? 0.1 : scene.grid;
+        expectSameAnswer(describeMap(maps[0].points, p), describeMap(maps[1].points, p), p,
+                         toString(type) + " " + noise + " seed " + std::to_string(seed), tally);
+      }
+}
