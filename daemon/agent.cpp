@@ -268,18 +268,20 @@ void Agent::claimAndCompute() {
 
 void Agent::finishCompute() {
   if (!worker_.ready()) return;
-  AgreedTransform t = worker_.take();
+  MatchWorker::Computed computed = worker_.take();
+  AgreedTransform& t = computed.transform;
   ++counters_.matches_computed;
   if (t.reliable && pairText(t.pair()) == config_.test_wrong_pair) {
     t.T_target_source = t.T_target_source * Pose4{1.5, 0, 0, radians(30)};
     log_.warning("test_wrong_pair: " + config_.test_wrong_pair + " published moved 1.5 m and 30 deg");
   }
   const Pose4& T = t.T_target_source;
-  log_.info("computed " + pairText(t.pair()) + " in " + fixed(t.seconds, 2) + " s: " +
-            (t.reliable
-                 ? "x " + fixed(T.x, 3) + " y " + fixed(T.y, 3) + " z " + fixed(T.z, 3) + " yaw " + fixed(T.yaw, 4) +
-                       ", support " + std::to_string(t.support) + ", " + std::to_string(t.inliers) + " inliers"
-                 : "no reliable match: " + t.reason));
+  log_.info(
+      "computed " + pairText(t.pair()) + " in " + fixed(t.seconds, 2) + " s (" + std::to_string(computed.slice_pairs) +
+      " slice pairs, " + std::to_string(computed.slice_pairs_recalled) + " kept from its last match): " +
+      (t.reliable ? "x " + fixed(T.x, 3) + " y " + fixed(T.y, 3) + " z " + fixed(T.z, 3) + " yaw " + fixed(T.yaw, 4) +
+                        ", support " + std::to_string(t.support) + ", " + std::to_string(t.inliers) + " inliers"
+                  : "no reliable match: " + t.reason));
   bus_->publish(transport::toWire(t));
   const PairKey pair = t.pair();
   board_.computed(std::move(t));

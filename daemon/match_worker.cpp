@@ -30,22 +30,26 @@ void MatchWorker::start(const PairAt& pair, std::shared_ptr<const MapFeatures> t
   done_ = false;
   thread_ = std::thread([this, pair, target = std::move(target), source = std::move(source), params, me] {
     const auto t0 = Clock::now();
-    AgreedTransform t;
+    Computed c;
+    AgreedTransform& t = c.transform;
     try {
-      t = agreedFromMatch(pair, matchFeatures(*target, *source, params), me);
+      const MatchResult r = matchFeatures(*target, *source, params, {}, &caches_[pair.pair]);
+      t = agreedFromMatch(pair, r, me);
+      c.slice_pairs = r.slice_pairs;
+      c.slice_pairs_recalled = r.slice_pairs_recalled;
     } catch (const std::exception& ex) {
       t = agreedFromMatch(pair, MatchResult{}, me);
       t.reason = ex.what();
     }
     t.computed_at_ms = wallMs();
     t.seconds = seconds(Clock::now() - t0);
-    result_ = std::move(t);
+    result_ = std::move(c);
     done_ = true;
     wake_();
   });
 }
 
-AgreedTransform MatchWorker::take() {
+MatchWorker::Computed MatchWorker::take() {
   thread_.join();
   done_ = false;
   return std::move(result_);

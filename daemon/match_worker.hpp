@@ -1,12 +1,16 @@
 #pragma once
 // Matching one pair on a thread of its own, so that the agent's loop keeps
-// serving peers meanwhile.
+// serving peers meanwhile. Each pair's slice-pair outcomes are remembered
+// until it is matched again (a map update), which then re-estimates only the
+// slice pairs whose content changed.
 #include <atomic>
 #include <functional>
+#include <map>
 #include <memory>
 #include <thread>
 
 #include "core/matcher.hpp"
+#include "core/pair_cache.hpp"
 #include "pair_board.hpp"
 
 namespace tomomap::daemon {
@@ -21,8 +25,13 @@ class MatchWorker {
   void start(const PairAt& pair, std::shared_ptr<const MapFeatures> target, std::shared_ptr<const MapFeatures> source,
              const MatchParams& params, const std::string& me);
   bool ready() const { return done_; }
+  struct Computed {
+    AgreedTransform transform;
+    size_t slice_pairs = 0;           ///< slice pairs the search needed
+    size_t slice_pairs_recalled = 0;  ///< of those, the ones remembered from the pair's last match
+  };
   /// The result, once ready(); the worker is idle again afterwards.
-  AgreedTransform take();
+  Computed take();
   /// Leaves a match in progress behind at exit: the fleet recomputes it.
   void abandon();
 
@@ -30,7 +39,10 @@ class MatchWorker {
   std::function<void()> wake_;
   std::thread thread_;
   std::atomic<bool> done_{false};
-  AgreedTransform result_;
+  Computed result_;
+  /// Touched only by the matching thread (one match at a time): at most one
+  /// table's outcomes for each pair this agent computes.
+  std::map<PairKey, PairCache> caches_;
 };
 
 /// The stored form of a match of `pair` computed by `me`.

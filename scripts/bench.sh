@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Speed and memory of `tomomap match`: median wall time over RUNS runs and peak
-# RSS of the whole process (load, filter, slice, features, match), per case.
+# RSS of the whole process (load, filter, slice, features, match), per case;
+# then re-matching after a map update, and pair matching against the number of
+# slices (which redraws docs/img/scaling.png).
 # Usage: scripts/bench.sh [RUNS]   (default 7; the build must exist: scripts/build.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -61,3 +63,12 @@ echo "synthetic street 240 m, $pts points per map:"
 for g in 0.5 0.2 0.1; do
   bench "  street (g $g)" "$s/map_0.pcd" "$s/map_1.pcd" "$g" --gt-target "$s/map_0-gtpose.txt" --gt-source "$s/map_1-gtpose.txt"
 done
+# Incremental re-matching (the daemon after a map update): one source slice
+# range changes; the pair is matched from scratch and with the rest recalled.
+rematch=${BUILD_DIR:-build}/tests/bench_rematch
+[ -f "$demo/demo-pcd1.pcd" ] && "$rematch" "$demo/demo-pcd1.pcd" "$demo/demo-pcd2.pcd" 0.05 "$runs"
+"$rematch" "$b/map_0.pcd" "$b/map_1.pcd" 0.05 "$runs"
+# Pair-matching time against slices (the building cropped by height), both
+# searches; redraws docs/img/scaling.png.
+echo "pair matching against slices, building at g 0.05:"
+"${BUILD_DIR:-build}/tests/bench_scaling" "$b/map_0.pcd" "$b/map_1.pcd" 0.05 docs/img/scaling.png "$(( runs < 3 ? runs : 3 ))"

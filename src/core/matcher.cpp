@@ -8,6 +8,7 @@
 #include "height_offsets.hpp"
 #include "map_check.hpp"
 #include "offset_search.hpp"
+#include "pair_cache.hpp"
 #include "refine.hpp"
 #include "text.hpp"
 #include "voxel_filter.hpp"
@@ -167,7 +168,7 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
 }
 
 MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
-                          const Progress& progress) {
+                          const Progress& progress, PairCache* cache) {
   MatchResult r;
   r.target_slices = target.slice_count;
   r.source_slices = source.slice_count;
@@ -193,9 +194,11 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   }
 
   auto t0 = Clock::now();
-  const SlicePairTable pairs = matchSlicePairs(target, source, params, progress);
+  const SlicePairTable pairs = matchSlicePairs(target, source, params, progress, cache);
+  if (cache) cache->keep(pairs, params);
   r.slice_pairs = pairs.matchedCount();
   r.slice_pairs_total = nt * ns;
+  r.slice_pairs_recalled = pairs.recalled;
   r.timings.pair_matching = secondsSince(t0);
 
   t0 = Clock::now();

@@ -59,16 +59,20 @@ struct MatchResult {
 
   int target_slices = 0, source_slices = 0;
   size_t target_features = 0, source_features = 0;
-  size_t slice_pairs = 0;        ///< slice pairs matched (all, or those the offset votes point to)
-  size_t slice_pairs_total = 0;  ///< n_target x n_source slices with features
+  size_t slice_pairs = 0;           ///< slice pairs matched (all, or those the offset votes point to)
+  size_t slice_pairs_total = 0;     ///< n_target x n_source slices with features
+  size_t slice_pairs_recalled = 0;  ///< of slice_pairs, those a PairCache remembered instead of matched
   StageTimings timings;
 };
 
 /// Finds T_target_source from two feature stacks of the same grid size: slice
 /// pairs estimated (slice_pairs.hpp), height offsets scored and the best picked
 /// (height_offsets.hpp), the winner refined (refine.hpp), the answer judged.
+/// With a `cache` (pair_cache.hpp), the slice pairs it remembers from the
+/// last match of these two maps are recalled, not matched again, and it then
+/// remembers this match's: the answer is the same either way.
 MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
-                          const Progress& progress = {});
+                          const Progress& progress = {}, PairCache* cache = nullptr);
 
 /// Why a described map is too tilted to match (see MatchParams::max_tilt and
 /// level), naming it by `role`; empty if it is fine.

@@ -108,17 +108,17 @@ std::vector<size_t> nextPairs(const SlicePairTable& table, const Diagonals& diag
 }  // namespace
 
 SlicePairTable matchSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
-                               const Progress& progress) {
+                               const Progress& progress, const PairCache* cache) {
   if (params.exhaustive || target.slices.empty() || source.slices.empty())
-    return estimateSlicePairs(target, source, params, progress);
-  SlicePairTable table(target.slices.size(), source.slices.size());
+    return estimateSlicePairs(target, source, params, progress, cache);
+  SlicePairTable table(target, source);
   const Diagonals diagonals(target, source, table);
   std::vector<size_t> todo;
   for (int peak : voteHeightOffsets(target, source, matchThreads(params)).peaks(kSmearSlices, kPeakShare, kMaxPeaks))
     addAround(peak, diagonals, todo);
   addSamples(diagonals, kSamplesPerOffset, todo);
   while (!todo.empty()) {
-    estimateSlicePairs(table, todo, target, source, params, progress);
+    estimateSlicePairs(table, todo, target, source, params, progress, cache);
     todo = nextPairs(table, diagonals, target, source, params);
   }
   return table;

@@ -13,7 +13,9 @@ namespace tomomap {
 /// promises a rival to the winner, until none is left unmatched. The winner's
 /// consensus and refinement then see exactly the pairs the exhaustive search
 /// would give them; offsets never completed had samples too weak to matter.
+/// Pairs `cache` (may be null) remembers are taken from it instead of matched:
+/// the same pairs are chosen and the same outcomes found either way.
 SlicePairTable matchSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
-                               const Progress& progress);
+                               const Progress& progress, const PairCache* cache = nullptr);
 
 }  // namespace tomomap

@@ -6,6 +6,7 @@
 #include <atomic>
 
 #include "hamming.hpp"
+#include "pair_cache.hpp"
 
 namespace tomomap {
 namespace {
@@ -45,19 +46,29 @@ Correspondences correspondencesOf(const SlicePairTable& table, const MapFeatures
   return positions(target.slices[a], source.slices[b], table.matches[table.index(a, b)]);
 }
 
+SlicePairTable::SlicePairTable(const MapFeatures& target, const MapFeatures& source)
+    : nt(target.slices.size()), ns(source.slices.size()), estimates(nt * ns), matches(nt * ns), matched(nt * ns, 0) {
+  for (const auto& s : target.slices) target_keys.push_back(sliceKey(s));
+  for (const auto& s : source.slices) source_keys.push_back(sliceKey(s));
+}
+
 size_t SlicePairTable::matchedCount() const {
   return static_cast<size_t>(std::count(matched.begin(), matched.end(), uint8_t{1}));
 }
 
 void estimateSlicePairs(SlicePairTable& table, const std::vector<size_t>& pairs, const MapFeatures& target,
-                        const MapFeatures& source, const MatchParams& params, const Progress& progress) {
+                        const MapFeatures& source, const MatchParams& params, const Progress& progress,
+                        const PairCache* cache) {
   std::vector<size_t> todo;  // each pair once, even if listed twice
   std::vector<uint8_t> listed(table.matched);
-  for (size_t k : pairs)
-    if (!listed[k]) {
-      listed[k] = 1;
+  for (size_t k : pairs) {
+    if (listed[k]) continue;
+    listed[k] = 1;
+    if (cache && cache->recall(table, k, params))
+      ++table.recalled;
+    else
       todo.push_back(k);
-    }
+  }
   const size_t n = todo.size();
   const RansacParams ransac = ransacParams(params);
   std::atomic<size_t> done{0};
@@ -72,8 +83,7 @@ void estimateSlicePairs(SlicePairTable& table, const std::vector<size_t>& pairs,
     for (const auto& [s, t] : matches) kept.emplace_back(static_cast<uint16_t>(s), static_cast<uint16_t>(t));
     if (matches.size() >= static_cast<size_t>(params.min_matches)) {
       const Correspondences c = positions(target.slices[a], source.slices[b], matches);
-      // Seeded per pair so results do not depend on thread scheduling.
-      if (auto est = ransacRigid2D(c, ransac, 0x9E3779B97F4A7C15ull * (a + 1) + b))
+      if (auto est = ransacRigid2D(c, ransac, pairSeed(table.target_keys[a], table.source_keys[b])))
         table.estimates[k] = {true, est->transform, static_cast<uint32_t>(est->inliers.size())};
     }
     table.matched[k] = 1;
@@ -86,11 +96,11 @@ void estimateSlicePairs(SlicePairTable& table, const std::vector<size_t>& pairs,
 }
 
 SlicePairTable estimateSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
-                                  const Progress& progress) {
-  SlicePairTable table(target.slices.size(), source.slices.size());
+                                  const Progress& progress, const PairCache* cache) {
+  SlicePairTable table(target, source);
   std::vector<size_t> all(table.estimates.size());
   for (size_t k = 0; k < all.size(); ++k) all[k] = k;
-  estimateSlicePairs(table, all, target, source, params, progress);
+  estimateSlicePairs(table, all, target, source, params, progress, cache);
   return table;
 }
 

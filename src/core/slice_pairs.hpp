@@ -27,11 +27,13 @@ struct SlicePairTable {
   size_t nt = 0, ns = 0;
   std::vector<PairEstimate> estimates;
   std::vector<std::vector<std::pair<uint16_t, uint16_t>>> matches;
-  std::vector<uint8_t> matched;  ///< 1 where the pair has been matched
+  std::vector<uint8_t> matched;                    ///< 1 where the pair has been matched
+  std::vector<uint64_t> target_keys, source_keys;  ///< each slice's content key (pair_cache.hpp)
+  size_t recalled = 0;                             ///< pairs taken from a PairCache instead of matched
 
   SlicePairTable() = default;
-  SlicePairTable(size_t n_target, size_t n_source)
-      : nt(n_target), ns(n_source), estimates(nt * ns), matches(nt * ns), matched(nt * ns, 0) {}
+  /// Nothing matched yet.
+  SlicePairTable(const MapFeatures& target, const MapFeatures& source);
   size_t index(size_t a, size_t b) const { return a * ns + b; }
   size_t matchedCount() const;
 };
@@ -40,16 +42,20 @@ struct SlicePairTable {
 /// as matched map-frame positions (source -> target).
 Correspondences matchSlices(const SliceFeatures& target, const SliceFeatures& source);
 
+class PairCache;
+
 /// Matches and estimates the pairs `pairs` (table indices) that are not matched
-/// yet, in parallel on matchThreads(params) threads. Each pair's RANSAC is
-/// seeded from its indices, so the result depends neither on scheduling nor
-/// on which other pairs were matched.
+/// yet, in parallel on matchThreads(params) threads, taking those `cache`
+/// (may be null) remembers instead. Each pair's RANSAC is seeded from its
+/// slices' content keys, so the result depends neither on scheduling nor on
+/// which other pairs were matched or recalled.
 void estimateSlicePairs(SlicePairTable& table, const std::vector<size_t>& pairs, const MapFeatures& target,
-                        const MapFeatures& source, const MatchParams& params, const Progress& progress);
+                        const MapFeatures& source, const MatchParams& params, const Progress& progress,
+                        const PairCache* cache = nullptr);
 
 /// Every slice pair matched and estimated.
 SlicePairTable estimateSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
-                                  const Progress& progress);
+                                  const Progress& progress, const PairCache* cache = nullptr);
 
 /// The stored matches of slice pair (a, b) as map-frame positions.
 Correspondences correspondencesOf(const SlicePairTable& table, const MapFeatures& target, const MapFeatures& source,

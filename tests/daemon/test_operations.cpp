@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <mutex>
 #include <random>
+#include <regex>
 #include <thread>
 
 #include "core/gravity.hpp"
@@ -293,6 +294,18 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
   EXPECT_EQ(view.output.find("STALE"), std::string::npos) << "the agreed transform is for the current maps";
   // One computation per version of the pair, fleet-wide.
   EXPECT_EQ(matchesComputed(fleet, {"alpha", "bravo"}), 2);
+  // The second matched again only the slice pairs with a changed slice.
+  const std::regex computed(R"(computed alpha<-bravo in ([0-9.]+) s \(([0-9]+) slice pairs, ([0-9]+) kept)");
+  std::vector<std::smatch> runs;
+  const std::string logs = fleet.log("alpha") + fleet.log("bravo");
+  for (std::sregex_iterator it(logs.begin(), logs.end(), computed), end; it != end; ++it) runs.push_back(*it);
+  ASSERT_EQ(runs.size(), 2u) << logs;
+  EXPECT_EQ(std::stoul(runs[0][3]), 0u) << runs[0].str();
+  const size_t pairs = std::stoul(runs[1][2]), kept = std::stoul(runs[1][3]);
+  EXPECT_GT(kept, pairs / 2) << runs[1].str() << ": most slices did not change";
+  EXPECT_LT(kept, pairs) << runs[1].str() << ": the cabinet's slices did";
+  std::printf("matching: first %s s (%s slice pairs), after the update %s s (%zu of %zu kept)\n",
+              runs[0][1].str().c_str(), runs[0][2].str().c_str(), runs[1][1].str().c_str(), kept, pairs);
   stopAll(fleet, {"alpha", "bravo"});
 }
 
