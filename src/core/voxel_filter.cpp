@@ -3,14 +3,19 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "huge_pages.hpp"
+
 namespace tomomap {
 namespace {
 
 /// The centroid of every run of equal cells in `sorted`, which holds (cell,
 /// point) in cell order; `cell` and `point` unpack an entry.
-template <typename Entry, typename CellOf, typename PointOf>
-Points centroids(const Points& in, const std::vector<Entry>& sorted, CellOf cell, PointOf point) {
+template <typename Entries, typename CellOf, typename PointOf>
+Points centroids(const Points& in, const Entries& sorted, CellOf cell, PointOf point) {
+  size_t runs = 0;  // counted first: a growing output of millions of points costs more than this pass
+  for (size_t k = 0; k < sorted.size(); ++k) runs += k == 0 || cell(sorted[k]) != cell(sorted[k - 1]);
   Points out;
+  out.reserve(runs);
   for (size_t b = 0; b < sorted.size();) {
     size_t e = b;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -22,6 +27,25 @@ Points centroids(const Points& in, const std::vector<Entry>& sorted, CellOf cell
     b = e;
   }
   return out;
+}
+
+/// Sorts words holding (cell << 32 | point) by cell, equal cells in the order
+/// given: a least-significant-digit radix sort over the bits `cells` needs,
+/// 11 bits a pass (a histogram that stays in L1). Built with points ascending,
+/// the result is that of std::sort on the words, in linear time.
+using Words = std::vector<uint64_t, HugePageAllocator<uint64_t>>;
+
+void sortByCell(Words& words, uint64_t cells) {
+  constexpr int kDigitBits = 11;
+  constexpr size_t kBuckets = size_t{1} << kDigitBits;
+  Words other(words.size());
+  for (int shift = 32; shift < 64 && ((cells - 1) >> (shift - 32)) != 0; shift += kDigitBits) {
+    std::vector<size_t> start(kBuckets + 1, 0);
+    for (uint64_t w : words) ++start[((w >> shift) & (kBuckets - 1)) + 1];
+    for (size_t b = 1; b <= kBuckets; ++b) start[b] += start[b - 1];
+    for (uint64_t w : words) other[start[(w >> shift) & (kBuckets - 1)]++] = w;
+    words.swap(other);
+  }
 }
 
 }  // namespace
@@ -46,11 +70,12 @@ Points voxelFilter(const Points& in, double leaf) {
   };
 
   // Most maps have under 2^32 cells: cell and point then share one 64-bit
-  // word, and sorting plain words is twice as fast as sorting pairs.
+  // word, sorted by radix in a few linear passes.
   if (nx * ny * nz <= (uint64_t{1} << 32) && in.size() <= (uint64_t{1} << 32)) {
-    std::vector<uint64_t> packed(in.size());
-    for (uint32_t i = 0; i < in.size(); ++i) packed[i] = cellOf(in[i]) << 32 | i;
-    std::sort(packed.begin(), packed.end());
+    Words packed;
+    packed.reserve(in.size());
+    for (uint32_t i = 0; i < in.size(); ++i) packed.push_back(cellOf(in[i]) << 32 | i);
+    sortByCell(packed, nx * ny * nz);
     return centroids(
         in, packed, [](uint64_t v) { return v >> 32; }, [](uint64_t v) { return v & 0xFFFFFFFFu; });
   }

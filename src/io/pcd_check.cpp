@@ -11,6 +11,8 @@
 #include <sstream>
 #include <vector>
 
+#include "core/huge_pages.hpp"
+
 namespace tomomap {
 namespace {
 
@@ -55,18 +57,11 @@ class MappedFile {
   size_t size_ = 0;
 };
 
-/// Scratch memory for a decompressed map, in huge pages where the kernel
-/// gives them: tens of megabytes touched once, where 4 kB pages cost a page
-/// fault each (a third of the load time on a virtual machine).
+/// Scratch memory for a decompressed map (core/huge_pages.hpp).
 class HugeBuffer {
  public:
-  explicit HugeBuffer(size_t size) : size_(size) {
-    void* p = ::mmap(nullptr, size_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (p == MAP_FAILED) throw std::bad_alloc();
-    ::madvise(p, size_, MADV_HUGEPAGE);
-    data_ = static_cast<char*>(p);
-  }
-  ~HugeBuffer() { ::munmap(data_, size_); }
+  explicit HugeBuffer(size_t size) : size_(size), data_(static_cast<char*>(hugeAllocate(size))) {}
+  ~HugeBuffer() { hugeFree(data_, size_); }
   HugeBuffer(const HugeBuffer&) = delete;
   HugeBuffer& operator=(const HugeBuffer&) = delete;
   char* get() const { return data_; }
