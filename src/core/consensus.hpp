@@ -1,5 +1,5 @@
 #pragma once
-// Consensus among per-slice-pair estimates at one height offset (ALGORITHM.md section 5).
+// Consensus among per-slice-pair estimates at one height offset (docs/algorithm.md).
 #include "rigid2d.hpp"
 
 namespace tomomap {

@@ -1,5 +1,5 @@
 #pragma once
-// Steps 2 and 3 of matching (ALGORITHM.md sections 5 and 6): the consensus of
+// Steps 2 and 3 of matching (docs/algorithm.md): the consensus of
 // the slice-pair estimates at every height offset, and the winning offset.
 #include <vector>
 

@@ -1,5 +1,5 @@
 #pragma once
-// Height cross-correlation of two tomographic feature stacks (ALGORITHM.md sections 4-7).
+// Height cross-correlation of two tomographic feature stacks (Unlu et al.; docs/algorithm.md).
 #include <optional>
 #include <string>
 

@@ -1,5 +1,5 @@
 #pragma once
-// Step 1 of matching (ALGORITHM.md section 4): every (target, source) slice
+// Step 1 of matching (docs/algorithm.md): every (target, source) slice
 // pair's descriptor matches and its robust 2D rigid estimate.
 #include <cstdint>
 #include <utility>

@@ -50,7 +50,7 @@ SliceStack makeSlices(const Points& points, double cell) {
     const int v = std::min(static_cast<int>((p.y() - g.y_min) / cell), g.height - 1);
     cells[static_cast<size_t>(k)].push_back(static_cast<uint32_t>(v * g.width + u));
   }
-  // Half of ALGORITHM.md's example (width + height): a noise-free street's two
+  // Half of the customary minimum (width + height cells): a noise-free street's two
   // facades are thin lines about as long as the image, and the full threshold
   // dropped exactly the slices that describe it.
   const size_t min_cells = static_cast<size_t>(g.width + g.height) / 2;
