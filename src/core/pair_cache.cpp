@@ -2,6 +2,8 @@
 
 #include <cstring>
 
+#include "hamming.hpp"
+
 namespace tomomap {
 namespace {
 
@@ -35,14 +37,7 @@ uint64_t settingsKey(const MatchParams& p) {
 uint64_t sliceKey(const SliceFeatures& s) {
   uint64_t h = combine(0, s.keypoints.size());
   for (const auto& k : s.keypoints) h = combine(h, bitsOf(k.x()) << 32 | bitsOf(k.y()));
-  for (int r = 0; r < s.descriptors.rows; ++r) {
-    const uint8_t* row = s.descriptors.ptr<uint8_t>(r);
-    for (int c = 0; c + 8 <= s.descriptors.cols; c += 8) {
-      uint64_t w = 0;
-      std::memcpy(&w, row + c, sizeof w);
-      h = combine(h, w);
-    }
-  }
+  for (uint64_t w : descriptorWords(s.descriptors)) h = combine(h, w);
   return h;
 }
 

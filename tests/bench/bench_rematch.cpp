@@ -10,17 +10,13 @@
 
 #include "core/matcher.hpp"
 #include "core/pair_cache.hpp"
+#include "core/stats.hpp"
 #include "io/map_io.hpp"
 #include "support.hpp"
 
 using namespace tomomap;
 
 namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : (v[v.size() / 2 - 1] + v[v.size() / 2]) / 2;
-}
 
 template <typename F>
 double secondsOf(F&& f) {
@@ -56,7 +52,7 @@ int main(int argc, char** argv) {
   std::printf(
       "re-match after a cabinet, g %.2f, median of %d: from scratch %.3f s, recalling %.3f s (%zu of %zu "
       "slice pairs recalled, %s answer)\n",
-      p.grid, runs, median(fresh), median(recalled), b.slice_pairs_recalled, b.slice_pairs,
+      p.grid, runs, quantile(fresh, 0.5), quantile(recalled, 0.5), b.slice_pairs_recalled, b.slice_pairs,
       same ? "the same" : "A DIFFERENT");
   return same ? 0 : 1;
 }

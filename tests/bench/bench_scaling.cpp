@@ -9,17 +9,13 @@
 #include <vector>
 
 #include "core/matcher.hpp"
+#include "core/stats.hpp"
 #include "io/map_io.hpp"
 #include "viz/line_plot.hpp"
 
 using namespace tomomap;
 
 namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : (v[v.size() / 2 - 1] + v[v.size() / 2]) / 2;
-}
 
 /// The points of `map` below `fraction` of its height.
 Points lowest(const Points& map, double fraction) {
@@ -61,12 +57,12 @@ int main(int argc, char** argv) {
     }
     same = same && ra.reliable == rb.reliable && ra.height_offset == rb.height_offset && ra.support == rb.support;
     const double slices = (t.slice_count + s.slice_count) / 2.0;
-    fast.x.push_back(slices), fast.y.push_back(median(a));
-    slow.x.push_back(slices), slow.y.push_back(median(b));
+    fast.x.push_back(slices), fast.y.push_back(quantile(a, 0.5));
+    slow.x.push_back(slices), slow.y.push_back(quantile(b, 0.5));
     std::printf("%5.0f slices, %4.0f features a slice: indexed %.3f s (%zu of %zu pairs), every pair %.3f s\n", slices,
                 static_cast<double>(t.featureCount() + s.featureCount()) /
                     static_cast<double>(t.slices.size() + s.slices.size()),
-                median(a), ra.slice_pairs, ra.slice_pairs_total, median(b));
+                quantile(a, 0.5), ra.slice_pairs, ra.slice_pairs_total, quantile(b, 0.5));
   }
   const double k_fast = viz::logLogSlope(fast.x, fast.y), k_slow = viz::logLogSlope(slow.x, slow.y);
   std::printf("log-log slope: indexed %.2f, every pair %.2f (medians of %d; %s answers)\n", k_fast, k_slow, runs,
