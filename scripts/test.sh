@@ -18,7 +18,14 @@ BUILD_DIR=build-asan TARGETS="unit_tests daemon_tests tomomapd tomomap" \
 # new_delete_type_mismatch=0: Debian's Fast DDS 2.9.1 deletes its statistics
 # reader (StatisticsReaderImpl, 64 bytes) through a base pointer of 56 bytes
 # when a participant is deleted; that is in the library, not in tomomap.
-export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:new_delete_type_mismatch=0
+# intercept_tls_get_addr=0: GCC 12's sanitizer runtime takes a dynamic TLS
+# block that happens to start 16 bytes into a page for a glibc 2.19 header and
+# reads a garbage range from it; the leak check at exit then dies scanning an
+# OpenMP worker ("Tracer caught signal 11 ... LeakSanitizer has encountered a
+# fatal error") after the test itself passed, about once in a hundred runs.
+# Without the interceptor the leak check still runs; it only stops treating
+# dynamic TLS blocks as roots of their own.
+export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:new_delete_type_mismatch=0:intercept_tls_get_addr=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 (cd build-asan && ctest --output-on-failure -j"$jobs" --timeout 1200 -L unit)
 # The daemon tests run secure participants: Fast DDS's own leaks there are
