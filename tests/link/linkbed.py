@@ -63,6 +63,39 @@ class Impairment:
         return False
 
 
+# RTPS submessage kinds, for --trace.
+SUBMESSAGES = {0x06: "ACKNACK", 0x07: "HEARTBEAT", 0x08: "GAP", 0x09: "INFO_TS", 0x0e: "INFO_DST",
+               0x12: "NACK_FRAG", 0x13: "HEARTBEAT_FRAG", 0x15: "DATA", 0x16: "DATA_FRAG", 0x31: "SEC_BODY",
+               0x32: "SEC_PREFIX", 0x33: "SEC_POSTFIX", 0x34: "SRTPS_PREFIX", 0x35: "SRTPS_POSTFIX"}
+# Entity ids (writer of DATA, DATA_FRAG, HEARTBEAT, GAP; reader of ACKNACK, NACK_FRAG) at these byte offsets
+# into the submessage.
+ENTITY_OFFSET = {0x15: 12, 0x16: 12, 0x07: 12, 0x13: 12, 0x08: 12, 0x06: 8, 0x12: 8}
+
+
+def describe_packet(packet):
+    """'<UDP destination port> <IP length> KIND:entity,...' for one IPv4/UDP/RTPS packet: what the
+    bytes on the link were (participant discovery is entity 000100c2, endpoint discovery 000003c2 and
+    000004c2; the tomomap topics' entities end in 02/03/04/07)."""
+    ihl = (packet[0] & 15) * 4
+    if len(packet) < ihl + 8 or packet[9] != 17:
+        return f"- {len(packet)} " + ("icmp" if packet[9] == 1 else f"ip-protocol-{packet[9]}")
+    port = struct.unpack(">H", packet[ihl + 2:ihl + 4])[0]
+    rtps = packet[ihl + 8:]
+    kinds = []
+    if rtps[:4] == b"RTPS":
+        off = 20
+        while off + 4 <= len(rtps):
+            kind, flags = rtps[off], rtps[off + 1]
+            length = struct.unpack("<H" if flags & 1 else ">H", rtps[off + 2:off + 4])[0]
+            name = SUBMESSAGES.get(kind, f"0x{kind:02x}")
+            at = ENTITY_OFFSET.get(kind)
+            kinds.append(name + (":" + rtps[off + at:off + at + 4].hex() if at and off + at + 4 <= len(rtps) else ""))
+            if length == 0:
+                break
+            off += 4 + length
+    return f"{port} {len(packet)} {','.join(kinds) or 'not-rtps'}"
+
+
 class Relay(threading.Thread):
     """The link between the agents, in user space (the kernel here has no netem).
 
@@ -77,9 +110,10 @@ class Relay(threading.Thread):
     IFF_TUN, IFF_NO_PI = 0x0001, 0x1000
     CLONE_NEWNET = 0x40000000
 
-    def __init__(self, impairment):
+    def __init__(self, impairment, trace=None):
         super().__init__(daemon=True)
         self.impairment = impairment
+        self.trace = trace  # open file: one line per packet carried, see --trace
         self.fds = {}  # destination IPv4 address (4 bytes) -> TUN fd
         self.running = True
         self.libc = ctypes.CDLL(None, use_errno=True)
@@ -115,7 +149,13 @@ class Relay(threading.Thread):
                 if len(packet) < 20 or packet[0] >> 4 != 4:
                     continue  # IPv4 only
                 out = self.fds.get(packet[16:20])
-                if out is None or self.impairment.drops(now):
+                if out is None:
+                    continue
+                dropped = self.impairment.drops(now)
+                if self.trace:
+                    self.trace.write(f"{now:.3f} {socket.inet_ntoa(packet[12:16])} {socket.inet_ntoa(packet[16:20])} "
+                                     f"{describe_packet(packet)}{' dropped' if dropped else ''}\n")
+                if dropped:
                     continue
                 seq += 1
                 heapq.heappush(pending, (now + self.impairment.delay, seq, out, packet))
@@ -137,9 +177,9 @@ class Relay(threading.Thread):
 class Bed:
     """N agent namespaces joined by the Relay, egress shaped per agent."""
 
-    def __init__(self, n, rate_kbit, prefix, impairment):
+    def __init__(self, n, rate_kbit, prefix, impairment, trace=None):
         self.n, self.rate_kbit, self.prefix = n, rate_kbit, prefix
-        self.relay = Relay(impairment)
+        self.relay = Relay(impairment, trace)
         self.made = []
 
     def ns(self, i):
@@ -202,15 +242,18 @@ def read_json(path):
 
 
 def peak_window_kbit(samples):
-    """Largest rate over any WINDOW_S-second window of (time, bytes) samples [kbit/s]."""
-    best = 0.0
+    """Largest rate over any WINDOW_S-second window of (time, bytes) samples
+    [kbit/s], and the time the window starts [s]."""
+    best, at = 0.0, 0.0
     for a in range(len(samples)):
         for b in range(a + 1, len(samples)):
             dt = samples[b][0] - samples[a][0]
             if dt >= WINDOW_S:
-                best = max(best, (samples[b][1] - samples[a][1]) * 8 / 1000 / dt)
+                rate = (samples[b][1] - samples[a][1]) * 8 / 1000 / dt
+                if rate > best:
+                    best, at = rate, samples[a][0]
                 break
-    return best
+    return best, at
 
 
 def main():
@@ -240,6 +283,8 @@ def main():
     p.add_argument("--max-peak-ratio", type=float, help="fail if an agent's peak 5 s egress exceeds this x budget")
     p.add_argument("--keep", help="keep configs, logs and state in this folder")
     p.add_argument("--secure", action="store_true", help="DDS Security on (keys from `tomomap fleet-keys`)")
+    p.add_argument("--trace", help="write one line per packet the relay carries: time [s, monotonic], source, "
+                   "destination, UDP port, IP length, RTPS submessages with their entity ids")
     args = p.parse_args()
     if os.geteuid() != 0:
         print("linkbed: needs root (network namespaces)", file=sys.stderr)
@@ -268,7 +313,9 @@ def main():
         return ["[security]", f'ca = "{d}/ca.pem"', f'certificate = "{d}/cert.pem"', f'private_key = "{d}/key.pem"',
                 f'governance = "{d}/governance.p7s"', f'permissions = "{d}/permissions.p7s"']
 
-    bed = Bed(n, args.rate_kbit, args.prefix, Impairment(args.loss, args.delay_ms, args.dropout_at, args.dropout_s))
+    trace = open(args.trace, "w") if args.trace else None
+    bed = Bed(n, args.rate_kbit, args.prefix, Impairment(args.loss, args.delay_ms, args.dropout_at, args.dropout_s),
+              trace)
     procs = []
     stop = {"now": False}
     signal.signal(signal.SIGTERM, lambda *_: stop.update(now=True))
@@ -309,12 +356,16 @@ def main():
             with open(f"{work}/a{i}.log") as f:
                 log = f.read()
             wire = samples[i][-1][1]
+            peak, peak_at = peak_window_kbit(samples[i])
             report["per_agent"][f"a{i}"] = {
                 "payload_bytes": payload,
                 "wire_bytes": wire,
                 "wire_per_payload_per_receiver": wire / max(1, payload * (n - 1)),
                 "daemon_sent_bytes": status.get("sent", {}).get("bytes", 0),
-                "peak_5s_kbit": peak_window_kbit(samples[i]),
+                "peak_5s_kbit": peak,
+                "peak_5s_starts_s": peak_at,
+                # what left the agent so far, once a second: [s, bytes]
+                "egress": [[round(t, 2), b] for t, b in samples[i]],
                 "re_requests": len(re.findall(r"asked \S+ again", log)),
             }
     finally:
@@ -327,6 +378,8 @@ def main():
             except subprocess.TimeoutExpired:
                 proc.kill()
         bed.down()
+        if trace:
+            trace.close()
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
 
@@ -339,7 +392,7 @@ def main():
     for a, r in report["per_agent"].items():
         print(f"  {a}: payload {r['payload_bytes']} B, on the wire {r['wire_bytes']} B "
               f"= {r['wire_per_payload_per_receiver']:.2f} x payload x {n - 1} receivers, "
-              f"peak {r['peak_5s_kbit']:.0f} kbit/s over {WINDOW_S} s, daemon counted {r['daemon_sent_bytes']} B, "
+              f"peak {r['peak_5s_kbit']:.0f} kbit/s over {WINDOW_S} s from {r['peak_5s_starts_s']:.0f} s, daemon counted {r['daemon_sent_bytes']} B, "
               f"{r['re_requests']} re-requests")
     if args.json:
         with open(args.json, "w") as f:
