@@ -1,7 +1,9 @@
 #pragma once
 // A DDS participant that talks only to the peers named in the config: UDPv4
-// unicast on explicit ports, multicast and shared memory off, and a flow
-// controller that holds the configured bandwidth budget (docs/protocol.md).
+// unicast on explicit ports, multicast and shared memory off, a flow
+// controller that shares the configured bandwidth budget between the slice
+// stream's receivers, and a pacer under all of it that holds the budget for
+// every datagram sent (docs/protocol.md).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -46,7 +48,7 @@ struct TransportConfig {
   uint16_t discovery_port = 0;
   uint16_t data_port = 0;
   std::vector<PeerAddress> peers;
-  double bandwidth_kbps = 10000;  ///< budget for slice data [kbit/s]
+  double bandwidth_kbps = 10000;  ///< budget for all of the agent's egress [kbit/s]
   int test_drop_percent = 0;      ///< test only: share of sent RTPS messages dropped [%]
   SecurityFiles security;
 };
@@ -75,8 +77,16 @@ int flowPeriodMs(const TransportConfig& c);
 /// The flow controller's name (a static string: Fast DDS keeps the pointer).
 extern const char* const kFlowControllerName;
 
+/// kbit/s as bytes per second.
+double bytesPerSecond(double kbps);
+
 /// Bytes the flow controller may send per period.
 size_t bytesPerPeriod(double bandwidth_kbps);
+
+/// The rate every datagram the participant sends is paced to [kbit/s]: a hard
+/// cap just under the budget, beneath the flow controller's share for the
+/// slice stream (EgressPacer).
+double pacedKbps(const TransportConfig& c);
 
 /// Largest slice sample: a fraction of the per-period budget, so that the
 /// controller, which sends only whole samples per period, fills each period

@@ -1,0 +1,22 @@
+#pragma once
+// Fast DDS's UDP transport with every datagram passed through an EgressPacer:
+// discovery, heartbeats, acknowledgements, repairs and data alike, so the
+// budget holds for all of an agent's egress, not only for what the flow
+// controller schedules.
+#include <fastdds/rtps/transport/ChainingTransportDescriptor.h>
+
+#include <memory>
+
+#include "egress_pacer.hpp"
+
+namespace tomomap::transport {
+
+struct PacedTransportDescriptor : eprosima::fastdds::rtps::ChainingTransportDescriptor {
+  PacedTransportDescriptor(std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface> udp,
+                           std::shared_ptr<EgressPacer> pacer);
+  eprosima::fastdds::rtps::TransportInterface* create_transport() const override;
+
+  std::shared_ptr<EgressPacer> pacer;
+};
+
+}  // namespace tomomap::transport
