@@ -55,6 +55,7 @@ void Agent::persist(bool transforms_changed) {
       pairs.push_back(p);
     }
     const auto& offer = sender_.offer();
+    const auto egress = bus_ ? bus_->egress() : transport::Bus::Egress{};
     const auto& a = offer.announcement;
     const auto& computing = board_.computing();
     nlohmann::json status{
@@ -78,6 +79,7 @@ void Agent::persist(bool transforms_changed) {
           {"raw_bytes", a.raw_bytes()}}},
         {"bandwidth_kbps", config_.transport.bandwidth_kbps},
         {"sent", {{"bytes", sender_.bytesSent()}, {"samples", sender_.samplesSent()}}},
+        {"egress", {{"wire_bytes", egress.wire_bytes}, {"dropped_datagrams", egress.dropped_datagrams}}},
         {"peers", peers},
         {"pairs", pairs},
         {"pairs_agreed", board_.results().size()},

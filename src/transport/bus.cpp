@@ -14,6 +14,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "egress_pacer.hpp"
 #include "senders.hpp"
 #include "tomomapPubSubTypes.h"
 
@@ -176,6 +177,7 @@ constexpr double kNackSuppressionMs = 500;  ///< longer than a link's round trip
 }  // namespace
 
 struct Bus::Impl {
+  std::shared_ptr<EgressPacer> pacer;
   DomainParticipant* participant = nullptr;
   Publisher* publisher = nullptr;
   Subscriber* subscriber = nullptr;
@@ -221,7 +223,8 @@ Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<
   auto& i = *impl_;
   i.handlers = h;
   i.watch = std::make_unique<ParticipantWatch>(i.senders, config.security.enabled(), i.handlers);
-  i.participant = createParticipant(config, i.watch.get());
+  i.pacer = std::make_shared<EgressPacer>(bytesPerSecond(pacedKbps(config)));
+  i.participant = createParticipant(config, i.pacer, i.watch.get());
   i.senders.bind(prefixOf(i.participant->guid().guidPrefix), config.agent);  // our own samples
   try {
     i.publisher = i.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
@@ -268,6 +271,8 @@ bool Bus::publish(const wire::MatchClaim& c) { return impl_->claims->write(const
 bool Bus::publish(const wire::TransformEstimate& e) {
   return impl_->estimates->write(const_cast<wire::TransformEstimate*>(&e));
 }
+
+Bus::Egress Bus::egress() const { return {impl_->pacer->sentBytes(), impl_->pacer->refusedDatagrams()}; }
 
 size_t Bus::sliceReaders() const {
   PublicationMatchedStatus status;

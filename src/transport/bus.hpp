@@ -48,6 +48,12 @@ class Bus {
   bool publish(const wire::TransformEstimate& e);
   /// Peers' slice readers matched to our slice writer now.
   size_t sliceReaders() const;
+  /// Everything the participant sent, as the pacer counted it on the wire.
+  struct Egress {
+    uint64_t wire_bytes = 0;         ///< with IP, UDP and Ethernet headers
+    uint64_t dropped_datagrams = 0;  ///< their deadline passed while they waited for the link
+  };
+  Egress egress() const;
   /// Serialised size of a slice sample [bytes].
   static size_t serializedSize(const wire::SliceFeatures& s);
 

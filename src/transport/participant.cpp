@@ -130,7 +130,8 @@ void addSecurity(const SecurityFiles& f, DomainParticipantQos& q) {
 
 }  // namespace
 
-DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipantListener* listener) {
+DomainParticipant* createParticipant(const TransportConfig& c, std::shared_ptr<EgressPacer> pacer,
+                                     DomainParticipantListener* listener) {
   DomainParticipantQos q;
   q.name(participantName(c.agent));
   if (c.security.enabled()) addSecurity(c.security, q);
@@ -156,8 +157,7 @@ DomainParticipant* createParticipant(const TransportConfig& c, DomainParticipant
   size_t datagram = std::max(kMtuPayload, sample);
   if (c.security.enabled()) datagram = std::max(datagram, handshakeBytes(c.security));
   transport->maxMessageSize = static_cast<uint32_t>(datagram);
-  q.transport().user_transports.push_back(std::make_shared<PacedTransportDescriptor>(
-      transport, std::make_shared<EgressPacer>(bytesPerSecond(pacedKbps(c)))));
+  q.transport().user_transports.push_back(std::make_shared<PacedTransportDescriptor>(transport, std::move(pacer)));
 
   auto& builtin = q.wire_protocol().builtin;
   builtin.metatrafficUnicastLocatorList.push_back(udp(c.address, c.discovery_port));

@@ -5,6 +5,7 @@
 // stream's receivers, and a pacer under all of it that holds the budget for
 // every datagram sent (docs/protocol.md).
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,8 @@ class DomainParticipantListener;
 }  // namespace eprosima::fastdds::dds
 
 namespace tomomap::transport {
+
+class EgressPacer;
 
 struct PeerAddress {
   std::string id;
@@ -98,10 +101,12 @@ size_t maxSampleBytes(double bandwidth_kbps, bool secure);
 /// The participant name an agent's daemon takes: "tomomapd/<agent>".
 std::string participantName(const std::string& agent);
 
-/// Creates the participant; throws std::runtime_error naming the cause.
+/// Creates the participant; throws std::runtime_error naming the cause. Every
+/// datagram it sends passes `pacer` (made for pacedKbps(config)).
 /// `listener` is attached at creation: set afterwards, it would miss the peers
 /// discovered in between (a peer already running is found at once).
 eprosima::fastdds::dds::DomainParticipant* createParticipant(
-    const TransportConfig& config, eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr);
+    const TransportConfig& config, std::shared_ptr<EgressPacer> pacer,
+    eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr);
 
 }  // namespace tomomap::transport

@@ -113,6 +113,12 @@ TEST(Daemons, AReceiverKilledMidTransferCompletesAfterRestart) {
   ASSERT_TRUE(t["reliable"].get<bool>());
   EXPECT_LT(poseError(poseOf(t), groundTruth(d + "demo-pcd1-gtpose.txt", d + "demo-pcd2-gtpose.txt")).translation,
             0.05);
+  // Everything alpha sent (discovery, acknowledgements and repairs with the
+  // slices, counted with their headers) stayed within its budget since it started.
+  const auto status = fleet.readJson("alpha", "status.json");
+  const double wire = status["egress"]["wire_bytes"].get<double>();
+  EXPECT_GT(wire, status["sent"]["bytes"].get<double>()) << status.dump(2);
+  EXPECT_LE(wire, 64 * 1000 / 8.0 * status["uptime_s"].get<double>() + 1514) << status.dump(2);
   stopAll(fleet, {"alpha", "bravo"});
 }
 

@@ -362,6 +362,10 @@ def main():
                 "wire_bytes": wire,
                 "wire_per_payload_per_receiver": wire / max(1, payload * (n - 1)),
                 "daemon_sent_bytes": status.get("sent", {}).get("bytes", 0),
+                # everything its participant sent, as its pacer counted it (with
+                # Ethernet headers, which a TUN device's counter leaves out)
+                "pacer_wire_bytes": status.get("egress", {}).get("wire_bytes", 0),
+                "pacer_dropped_datagrams": status.get("egress", {}).get("dropped_datagrams", 0),
                 "peak_5s_kbit": peak,
                 "peak_5s_starts_s": peak_at,
                 # what left the agent so far, once a second: [s, bytes]
@@ -392,8 +396,9 @@ def main():
     for a, r in report["per_agent"].items():
         print(f"  {a}: payload {r['payload_bytes']} B, on the wire {r['wire_bytes']} B "
               f"= {r['wire_per_payload_per_receiver']:.2f} x payload x {n - 1} receivers, "
-              f"peak {r['peak_5s_kbit']:.0f} kbit/s over {WINDOW_S} s from {r['peak_5s_starts_s']:.0f} s, daemon counted {r['daemon_sent_bytes']} B, "
-              f"{r['re_requests']} re-requests")
+              f"peak {r['peak_5s_kbit']:.0f} kbit/s over {WINDOW_S} s from {r['peak_5s_starts_s']:.0f} s, daemon counted {r['daemon_sent_bytes']} B "
+              f"of slices and {r['pacer_wire_bytes']} B in all ({r['pacer_dropped_datagrams']} datagrams dropped "
+              f"waiting for the link), {r['re_requests']} re-requests")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(report, f, indent=2)
