@@ -1,7 +1,7 @@
 #pragma once
 // The hard cap under the budget: every datagram the participant sends, of any
 // kind, waits for its turn on a virtual link running at the pacer's rate
-// (docs/protocol.md, "The budget is total egress").
+// (docs/protocol.md, "A pacer under everything").
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -36,7 +36,6 @@ class EgressPacer {
   /// A datagram of `wire_bytes` left at `at`: the link is busy for its bytes / rate.
   void sent(size_t wire_bytes, Clock::time_point at);
 
-  double bytesPerSecond() const { return bytes_per_s_; }
   uint64_t sentBytes() const;
   uint64_t refusedDatagrams() const;
 

@@ -35,7 +35,9 @@ class PacedTransport : public rtps::ChainingTransport {
   /// Sends one datagram per destination, each when the pacer finds the link
   /// free. Fast DDS offers every message to each of its sender resources
   /// (sockets) in turn and only the one whose purpose fits sends it, so only
-  /// what the socket really sent occupies the link. A datagram that cannot
+  /// what the socket really sent occupies the link (the others' turns still
+  /// wait for the link to be free, which costs no throughput: the next
+  /// datagram would have waited as long). A datagram that cannot
   /// start before its deadline is dropped, as a full socket would drop it,
   /// and the protocol repairs it like any loss on the link.
   bool send(SenderResource* low, const octet* buffer, uint32_t size, rtps::LocatorsIterator* begin,
