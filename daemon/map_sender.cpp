@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "transport/participant.hpp"
+
 namespace tomomap::daemon {
 
 MapSender::MapSender(double stream_kbps, Clock::duration grace)
@@ -24,7 +26,7 @@ void MapSender::setOffer(transport::MapOffer offer) {
 
 Clock::duration MapSender::leaveTime(size_t bytes) const {
   return std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(static_cast<double>(bytes) * 8 / 1000 / kbps_));
+      std::chrono::duration<double>(static_cast<double>(bytes) / transport::bytesPerSecond(kbps_)));
 }
 
 size_t MapSender::sliceBytes(int slice) const {

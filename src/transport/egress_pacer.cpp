@@ -6,11 +6,6 @@
 
 namespace tomomap::transport {
 
-namespace {
-constexpr size_t kUdpHeader = 8, kIpv4Header = 20, kEthernetHeader = 14;
-constexpr size_t kEthernetPayload = 1500;  ///< an IPv4 packet in one frame
-}  // namespace
-
 size_t wireBytes(size_t udp_payload) {
   const size_t ip_payload = udp_payload + kUdpHeader;
   const size_t per_fragment = kEthernetPayload - kIpv4Header;  // 1480, a multiple of 8 as IPv4 requires

@@ -10,6 +10,11 @@
 
 namespace tomomap::transport {
 
+constexpr size_t kUdpHeader = 8, kIpv4Header = 20, kEthernetHeader = 14;
+constexpr size_t kEthernetPayload = 1500;  ///< an IPv4 packet in one frame
+/// The largest UDP payload that IP does not fragment on Ethernet (1472).
+constexpr size_t kUdpPayloadInOneFrame = kEthernetPayload - kIpv4Header - kUdpHeader;
+
 /// Bytes a UDP datagram with this payload puts on an Ethernet link: UDP, IPv4
 /// and Ethernet headers, and the IPv4 and Ethernet headers again for every
 /// further fragment of a datagram larger than one frame.

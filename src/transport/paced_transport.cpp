@@ -2,8 +2,6 @@
 
 #include <fastdds/rtps/transport/ChainingTransport.h>
 
-#include <vector>
-
 namespace tomomap::transport {
 
 namespace rtps = eprosima::fastdds::rtps;
@@ -42,17 +40,17 @@ class PacedTransport : public rtps::ChainingTransport {
   /// and the protocol repairs it like any loss on the link.
   bool send(SenderResource* low, const octet* buffer, uint32_t size, rtps::LocatorsIterator* begin,
             rtps::LocatorsIterator* end, const std::chrono::steady_clock::time_point& deadline) override {
-    std::vector<Locator_t> destinations;
-    for (auto& it = *begin; it != *end; ++it)
-      if (low_level_transport_->IsLocatorSupported(*it)) destinations.push_back(*it);
     bool sent = false;
-    for (const auto& destination : destinations)
+    for (auto& it = *begin; it != *end; ++it) {
+      if (!low_level_transport_->IsLocatorSupported(*it)) continue;
+      const Locator_t destination = *it;
       descriptor_.pacer->send(deadline, [&]() -> size_t {
         OneLocator first(&destination), last(&destination + 1);
         if (!low->send(buffer, size, &first, &last, deadline)) return 0;
         sent = true;
         return wireBytes(size);
       });
+    }
     return sent;
   }
 

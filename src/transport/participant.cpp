@@ -13,6 +13,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "egress_pacer.hpp"
 #include "paced_transport.hpp"
 
 namespace tomomap::transport {
@@ -61,7 +62,7 @@ int flowPeriodMs(const TransportConfig& c) { return kFlowPeriodMs * static_cast<
 
 namespace {
 
-constexpr size_t kMtuPayload = 1472;  ///< UDP payload of a 1500-byte Ethernet frame
+constexpr size_t kMtuPayload = kUdpPayloadInOneFrame;
 /// RTPS around one sample in a datagram: header, INFO_TS, DATA submessage with
 /// the key hash inline (about 100 bytes seen), with a margin.
 constexpr size_t kRtpsOverhead = 128;
