@@ -225,7 +225,10 @@ void Agent::onPeer(const std::string& id, bool alive) {
     board_.agentUp(id);
     requestMissing(/*at_once=*/true);  // a request sent before it could hear us was lost
     // Durability is meant to give it our announcement, but Fast DDS misses a
-    // late reader now and then (eProsima/Fast-DDS#3822): announce again soon.
+    // late reader now and then (eProsima/Fast-DDS#3822): announce again soon,
+    // unless it asks for our slices first. A peer that comes up again may have
+    // restarted without it.
+    sender_.forget(id);
     reannounce_ = true;
     // A late joiner gets what this agent computed, in case durability missed it.
     for (const auto* held : {&board_.results(), &board_.keptBeside()})

@@ -140,12 +140,14 @@ void Agent::tick(Clock::time_point& last_announce) {
   for (const auto& line : rejections_.due(now)) log_.warning(line);
   // Repairs a lost or missed announcement. After a peer appeared, once, a
   // little later: peers that appear together get one announcement, since each
-  // reaches every receiver.
-  if (offering() &&
-      (now - last_announce > kReannounce || (reannounce_ && now - last_announce > kReannounceAfterPeer))) {
+  // reaches every receiver. Not while every live peer has shown it holds it
+  // (it asked for our slices): each copy goes to every peer, some 1.2 kB
+  // each with a hundred slices.
+  const bool due = now - last_announce > kReannounce || (reannounce_ && now - last_announce > kReannounceAfterPeer);
+  if (due && offering()) {
     reannounce_ = false;
-    bus_->publish(sender_.offer().announcement);
     last_announce = now;
+    if (!sender_.informed(peers_.alive())) bus_->publish(sender_.offer().announcement);
   }
   if (now - last_status_ > kStatusEvery) {
     persist(false);

@@ -21,7 +21,12 @@ void MapSender::setOffer(transport::MapOffer offer) {
   next_part_ = 0;
   leaves_at_.clear();
   expected_until_.clear();
+  informed_.clear();
   queued_since_.reset();
+}
+
+bool MapSender::informed(const std::set<std::string>& peers) const {
+  return std::includes(informed_.begin(), informed_.end(), peers.begin(), peers.end());
 }
 
 Clock::duration MapSender::leaveTime(size_t bytes) const {
@@ -38,6 +43,7 @@ size_t MapSender::sliceBytes(int slice) const {
 size_t MapSender::request(const std::string& requester, uint64_t version, const std::vector<int32_t>& slices,
                           Clock::duration stalled, Clock::time_point now) {
   if (version != offer_.announcement.version()) return 0;
+  informed_.insert(requester);
   std::vector<int> wanted;
   if (slices.empty())
     for (const auto& e : offer_.announcement.slices()) wanted.push_back(e.slice());

@@ -47,6 +47,13 @@ class MapSender {
   size_t request(const std::string& requester, uint64_t version, const std::vector<int32_t>& slices,
                  Clock::duration stalled, Clock::time_point now);
 
+  /// Peers that asked for slices of the current version hold its
+  /// announcement; `forget` one that restarted (it lost it).
+  void forget(const std::string& peer) { informed_.erase(peer); }
+  /// Whether every one of `peers` holds the current announcement: announcing
+  /// it again would reach no one who needs it.
+  bool informed(const std::set<std::string>& peers) const;
+
   /// Whether to start sending what is queued: once every live peer's reader
   /// has matched the writer (a reader that matches later gets the slices
   /// from the history, but only after everything else queued), or after
@@ -102,6 +109,7 @@ class MapSender {
   /// Per requester: until when copies already written may still be on their
   /// way to it (a late reader gets the history after the backlog).
   std::map<std::string, Clock::time_point> expected_until_;
+  std::set<std::string> informed_;                 ///< peers that asked for the current version
   std::optional<Clock::time_point> queued_since_;  ///< when the queue last had something waiting to start
   size_t bytes_sent_ = 0, samples_sent_ = 0, resends_ = 0;
 };

@@ -59,6 +59,7 @@ class PeerMaps {
   /// Discovery: a peer's participant came (true) or went; returns whether that changed anything.
   bool setAlive(const std::string& peer, bool alive);
   size_t aliveCount() const { return alive_.size(); }
+  const std::set<std::string>& alive() const { return alive_; }
   /// A sample from `peer` arrived (wall time, for status).
   void seen(const std::string& peer, uint64_t wall_ms) { last_seen_ms_[peer] = wall_ms; }
   /// Drops every peer `keep` rejects (a reload removed it from the config).

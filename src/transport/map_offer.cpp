@@ -13,9 +13,15 @@
 namespace tomomap::transport {
 namespace {
 
-/// Room a sample's own fields take besides its payload (agent, version, slice,
-/// part numbers, encoding, sequence lengths), with margin.
-constexpr size_t kSampleHeaderBytes = 256;
+/// Bytes a sample of `agent` takes besides its payload: its own fields
+/// (agent, version, slice, part numbers, encoding, both sequence lengths), as
+/// the generated code serializes them, plus the up to 3 bytes that align the
+/// second sequence's length after a run of features.
+size_t sampleHeaderBytes(const std::string& agent) {
+  wire::SliceFeatures empty;
+  empty.agent(agent);
+  return wire::SliceFeatures::getCdrSerializedSize(empty) + 3;
+}
 /// Feature settings outside these are refused: a receiver would otherwise run
 /// ORB with whatever a peer names.
 constexpr int kMaxFeaturesCap = 10000, kMaxPad = 256;
@@ -64,8 +70,8 @@ std::vector<wire::SliceFeatures> cutSlice(const std::string& agent, const SliceF
 MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const FeatureParams& params, uint64_t raw_bytes,
                    size_t max_sample_bytes) {
   const SliceGrid& g = f.occupancy.grid;
-  const size_t room =
-      max_sample_bytes > kSampleHeaderBytes + kFeatureBytes ? max_sample_bytes - kSampleHeaderBytes : kFeatureBytes;
+  const size_t header = sampleHeaderBytes(agent);
+  const size_t room = max_sample_bytes > header + kFeatureBytes ? max_sample_bytes - header : kFeatureBytes;
   const size_t features_per_part = std::clamp<size_t>(room / kFeatureBytes, 1, wire::MAX_FEATURES_PER_SAMPLE);
   const size_t bytes_per_part = std::clamp<size_t>(room, 1, wire::MAX_OCCUPANCY_PER_SAMPLE);
 

@@ -58,14 +58,19 @@ double streamKbps(const TransportConfig& c) {
   return (1 - controlShare(c)) * c.bandwidth_kbps / static_cast<double>(receivers(c));
 }
 
-int flowPeriodMs(const TransportConfig& c) { return kFlowPeriodMs * static_cast<int>(receivers(c)); }
-
 namespace {
 
 constexpr size_t kMtuPayload = kUdpPayloadInOneFrame;
-/// RTPS around one sample in a datagram: header, INFO_TS, DATA submessage with
-/// the key hash inline (about 100 bytes seen), with a margin.
-constexpr size_t kRtpsOverhead = 128;
+/// Datagram bytes besides a sample's CDR that keep the sample one DATA
+/// submessage. Fast DDS 2.9 cuts a sample into DATA_FRAGs when its serialized
+/// payload (the CDR after a 4-byte encapsulation header) exceeds the message
+/// size less 116 bytes it keeps for headers (RTPS header, INFO_DST, INFO_TS,
+/// a DATA_FRAG header, a piggybacked HEARTBEAT) and less the 60-byte
+/// statistics submessage Debian's build ends every message with. 16 bytes of
+/// margin. (A reserve of 160 had every full sample cut in two, 1,452 and 176
+/// bytes on the link; 128 plus a 256-byte sample header before left 220 bytes
+/// of every full datagram empty.)
+constexpr size_t kRtpsOverhead = 116 + 60 + 4 + 16;
 /// What DDS Security adds to a sample with metadata_protection_kind ENCRYPT:
 /// SEC_PREFIX (24 bytes), SEC_POSTFIX (a 16-byte MAC and its count) and the
 /// encrypted body's framing, with a margin.
@@ -94,16 +99,23 @@ constexpr int kLeaseS = 60;
 }  // namespace
 
 size_t maxSampleBytes(double kbps, bool secure) {
-  // The controller sends whole samples only and a sample that does not fit the
-  // rest of a period waits for the next one. Slices vary in size, so with
-  // samples of up to an eighth of the period's budget at most about one
-  // eighth of a period goes unused (one sample per period as at first lost up
-  // to half). Thin budgets: one sample fills one Ethernet-sized datagram (each
-  // datagram costs its headers; smaller samples paid them more often). And no
+  // A kSamplesPerPeriod-th of a period's bytes (one sample per period as at
+  // first lost up to half of it). Thin budgets: one sample fills one
+  // Ethernet-sized datagram (each datagram costs its headers; smaller samples
+  // paid them more often), and the period grows instead (flowBaseMs). And no
   // sample may exceed one UDP datagram.
   constexpr size_t kDatagram = 60000;
-  return std::clamp<size_t>(bytesPerPeriod(kbps) / 8, kMtuPayload, kDatagram) - overhead(secure);
+  return std::clamp<size_t>(bytesPerPeriod(kbps) / kSamplesPerPeriod, kMtuPayload, kDatagram) - overhead(secure);
 }
+
+int flowBaseMs(const TransportConfig& c) {
+  const bool secure = c.security.enabled();
+  const double sample = static_cast<double>(maxSampleBytes(c.bandwidth_kbps, secure) + overhead(secure));
+  const double stream = bytesPerSecond((1 - controlShare(c)) * c.bandwidth_kbps);
+  return std::max(kFlowPeriodMs, static_cast<int>(std::ceil(1000.0 * kSamplesPerPeriod * sample / stream)));
+}
+
+int flowPeriodMs(const TransportConfig& c) { return flowBaseMs(c) * static_cast<int>(receivers(c)); }
 
 namespace {
 
@@ -181,7 +193,8 @@ DomainParticipant* createParticipant(const TransportConfig& c, std::shared_ptr<E
   flow->scheduler = eprosima::fastdds::rtps::FlowControllerSchedulerPolicy::FIFO;
   // Per stretched period, the stream's share for every receiver: each byte
   // written leaves once per receiver, so the egress stays within the budget.
-  flow->max_bytes_per_period = static_cast<int32_t>(bytesPerPeriod((1 - controlShare(c)) * c.bandwidth_kbps));
+  flow->max_bytes_per_period =
+      static_cast<int32_t>(bytesPerSecond((1 - controlShare(c)) * c.bandwidth_kbps) * flowBaseMs(c) / 1000.0);
   flow->period_ms = static_cast<uint64_t>(flowPeriodMs(c));
   q.flow_controllers().push_back(flow);
 

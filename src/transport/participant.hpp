@@ -56,8 +56,13 @@ struct TransportConfig {
   SecurityFiles security;
 };
 
-/// Flow-controller period [ms] with one receiver: the budget is enforced per period.
+/// Flow-controller period [ms] with one receiver at budgets where a sample is
+/// smaller than an eighth of it (flowPeriodMs).
 constexpr int kFlowPeriodMs = 100;
+/// The controller sends whole samples only, and one that does not fit the
+/// rest of a period waits for the next: with at least this many samples a
+/// period, at most about an eighth of the stream's rate goes unused.
+constexpr int kSamplesPerPeriod = 8;
 
 /// Share of the budget left to control traffic (discovery, heartbeats,
 /// acknowledgements, requests, claims, estimates, announcements), which does
@@ -72,10 +77,18 @@ double controlShare(const TransportConfig& c);
 /// configured peers (at least one).
 double streamKbps(const TransportConfig& c);
 
-/// The flow controller's period [ms]: bytesPerPeriod(bandwidth_kbps) leave per
-/// period as samples, each reaching every receiver, so the period stretches
-/// with the receivers instead of the bytes per period shrinking (a sample must
-/// fit one period's bytes, and the sample size must not depend on the fleet).
+/// The flow controller's period [ms] with one receiver: kFlowPeriodMs, or
+/// longer where the stream's bytes in it would hold fewer than
+/// kSamplesPerPeriod of the largest samples (thin budgets, where a sample is
+/// one Ethernet datagram: at 250 kbit/s with four receivers, samples of
+/// 1.3 kB and 100 ms, one sample fitted where two did not and the stream ran
+/// at half its rate).
+int flowBaseMs(const TransportConfig& c);
+/// The flow controller's period [ms]: flowBaseMs stretched by the receivers.
+/// The stream's bytes of one base period leave per period as samples, each
+/// reaching every receiver, so the period stretches with the receivers
+/// instead of the bytes per period shrinking (a sample must fit one period's
+/// bytes, and the sample size must not depend on the fleet).
 int flowPeriodMs(const TransportConfig& c);
 /// The flow controller's name (a static string: Fast DDS keeps the pointer).
 extern const char* const kFlowControllerName;

@@ -183,3 +183,21 @@ TEST(MapSender, ARequesterThatIsStillReceivingIsLeftToTheRepairs) {
   m.request("bravo", 9, {0}, 15s, t0 + 20s);
   EXPECT_EQ(m.queued(), 1u);
 }
+
+TEST(MapSender, APeerThatAskedForTheCurrentVersionHoldsItsAnnouncement) {
+  MapSender s(80, 1s);
+  s.setOffer(fakeOffer(3, 1, 7));
+  const auto now = Clock::now();
+  EXPECT_TRUE(s.informed({})) << "no live peer needs it";
+  EXPECT_FALSE(s.informed({"bravo"}));
+  s.request("bravo", 6, {}, 0s, now);
+  EXPECT_FALSE(s.informed({"bravo"})) << "asked about an older version";
+  s.request("bravo", 7, {1}, 0s, now);
+  EXPECT_TRUE(s.informed({"bravo"}));
+  EXPECT_FALSE(s.informed({"bravo", "charlie"}));
+  s.forget("bravo");  // it came up again: a restart loses what it held
+  EXPECT_FALSE(s.informed({"bravo"}));
+  s.request("bravo", 7, {}, 0s, now);
+  s.setOffer(fakeOffer(3, 1, 8));
+  EXPECT_FALSE(s.informed({"bravo"})) << "a new version is news to everyone";
+}

@@ -78,12 +78,20 @@ TEST(SliceCodec, SamplesFitTheBudgetAndTheCheaperEncodingIsChosen) {
   const size_t budget = maxSampleBytes(1000, /*secure=*/true);  // 1 Mbit/s
   EXPECT_LE(budget, bytesPerPeriod(1000));
   const MapOffer offer = makeOffer("alpha", f, {}, 1000000, budget);
-  size_t features = 0, occupancy = 0;
+  size_t features = 0, occupancy = 0, full_parts = 0;
   for (const auto& [k, samples] : offer.samples)
     for (const auto& s : samples) {
-      EXPECT_LE(wire::SliceFeatures::getCdrSerializedSize(s), budget);
+      const size_t size = wire::SliceFeatures::getCdrSerializedSize(s);
+      EXPECT_LE(size, budget);
       (s.encoding() == wire::SliceEncoding::OCCUPANCY ? occupancy : features)++;
+      // Every part but a slice's last fills the sample: each datagram pays
+      // its headers, so room left empty costs bytes on the link.
+      if (s.part() + 1 < s.parts()) {
+        ++full_parts;
+        EXPECT_GT(size + kFeatureBytes + 3, budget) << "slice " << s.slice() << " part " << s.part();
+      }
     }
+  EXPECT_GT(full_parts, 0u) << "the sample map has slices larger than one sample";
   EXPECT_GT(occupancy + features, 0u);
   size_t feature_bytes = kFeatureBytes * f.featureCount();
   EXPECT_LE(offer.payload_bytes, feature_bytes) << "never more than sending every feature";
@@ -222,4 +230,21 @@ TEST(SliceCodec, AMapOverTheMemoryBudgetIsRefusedBeforeAndWhileItArrives) {
   for (const auto& [k, samples] : offer.samples)
     for (const auto& s : samples) EXPECT_FALSE(roomy.accept(s));
   EXPECT_TRUE(roomy.complete()) << "the same map within a budget that holds it";
+}
+
+TEST(SliceCodec, EveryFlowPeriodHoldsSeveralOfTheLargestSamples) {
+  // The flow controller sends whole samples: a period that holds one and a
+  // half of them sends one, and the stream runs at two thirds of its rate.
+  for (const double kbps : {64.0, 250.0, 800.0, 1000.0, 10000.0})
+    for (const size_t peers : {1, 2, 4, 6}) {
+      TransportConfig c;
+      c.bandwidth_kbps = kbps;
+      c.peers.resize(peers);
+      const double stream_bytes_per_base = bytesPerSecond((1 - controlShare(c)) * kbps) * flowBaseMs(c) / 1000.0;
+      EXPECT_GE(stream_bytes_per_base, kSamplesPerPeriod * maxSampleBytes(kbps, false)) << kbps << " " << peers;
+      EXPECT_GE(flowBaseMs(c), kFlowPeriodMs);
+      EXPECT_EQ(flowPeriodMs(c), flowBaseMs(c) * static_cast<int>(peers));
+      // Per period of every receiver, the same stream rate (kbit/s).
+      EXPECT_NEAR(stream_bytes_per_base * 8 / flowPeriodMs(c), streamKbps(c), 0.01 * streamKbps(c));
+    }
 }
