@@ -108,14 +108,25 @@ size_t maxSampleBytes(double kbps, bool secure) {
   return std::clamp<size_t>(bytesPerPeriod(kbps) / kSamplesPerPeriod, kMtuPayload, kDatagram) - overhead(secure);
 }
 
+namespace {
+/// The slice stream's bytes written per second (each then reaches every receiver).
+double streamBytesPerSecond(const TransportConfig& c) {
+  return bytesPerSecond(streamKbps(c) * static_cast<double>(receivers(c)));
+}
+}  // namespace
+
 int flowBaseMs(const TransportConfig& c) {
   const bool secure = c.security.enabled();
   const double sample = static_cast<double>(maxSampleBytes(c.bandwidth_kbps, secure) + overhead(secure));
-  const double stream = bytesPerSecond((1 - controlShare(c)) * c.bandwidth_kbps);
-  return std::max(kFlowPeriodMs, static_cast<int>(std::ceil(1000.0 * kSamplesPerPeriod * sample / stream)));
+  return std::max(kFlowPeriodMs,
+                  static_cast<int>(std::ceil(1000.0 * kSamplesPerPeriod * sample / streamBytesPerSecond(c))));
 }
 
 int flowPeriodMs(const TransportConfig& c) { return flowBaseMs(c) * static_cast<int>(receivers(c)); }
+
+size_t flowBytesPerPeriod(const TransportConfig& c) {
+  return static_cast<size_t>(streamBytesPerSecond(c) * flowBaseMs(c) / 1000.0);
+}
 
 namespace {
 
@@ -193,8 +204,7 @@ DomainParticipant* createParticipant(const TransportConfig& c, std::shared_ptr<E
   flow->scheduler = eprosima::fastdds::rtps::FlowControllerSchedulerPolicy::FIFO;
   // Per stretched period, the stream's share for every receiver: each byte
   // written leaves once per receiver, so the egress stays within the budget.
-  flow->max_bytes_per_period =
-      static_cast<int32_t>(bytesPerSecond((1 - controlShare(c)) * c.bandwidth_kbps) * flowBaseMs(c) / 1000.0);
+  flow->max_bytes_per_period = static_cast<int32_t>(flowBytesPerPeriod(c));
   flow->period_ms = static_cast<uint64_t>(flowPeriodMs(c));
   q.flow_controllers().push_back(flow);
 

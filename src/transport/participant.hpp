@@ -56,8 +56,8 @@ struct TransportConfig {
   SecurityFiles security;
 };
 
-/// Flow-controller period [ms] with one receiver at budgets where a sample is
-/// smaller than an eighth of it (flowPeriodMs).
+/// Flow-controller period [ms] with one receiver, unless it would hold fewer
+/// than kSamplesPerPeriod samples (flowBaseMs).
 constexpr int kFlowPeriodMs = 100;
 /// The controller sends whole samples only, and one that does not fit the
 /// rest of a period waits for the next: with at least this many samples a
@@ -90,6 +90,9 @@ int flowBaseMs(const TransportConfig& c);
 /// instead of the bytes per period shrinking (a sample must fit one period's
 /// bytes, and the sample size must not depend on the fleet).
 int flowPeriodMs(const TransportConfig& c);
+/// Bytes of samples the flow controller lets out per period (each then
+/// reaching every receiver): the stream's share of one base period.
+size_t flowBytesPerPeriod(const TransportConfig& c);
 /// The flow controller's name (a static string: Fast DDS keeps the pointer).
 extern const char* const kFlowControllerName;
 
