@@ -60,7 +60,6 @@ double streamKbps(const TransportConfig& c) {
 
 namespace {
 
-constexpr size_t kMtuPayload = kUdpPayloadInOneFrame;
 /// Datagram bytes besides a sample's CDR that keep the sample one DATA
 /// submessage. Fast DDS 2.9 cuts a sample into DATA_FRAGs when its serialized
 /// payload (the CDR after a 4-byte encapsulation header) exceeds the message
@@ -98,26 +97,30 @@ constexpr int kLeaseS = 60;
 
 }  // namespace
 
-size_t maxSampleBytes(double kbps, bool secure) {
-  // A kSamplesPerPeriod-th of a period's bytes (one sample per period as at
-  // first lost up to half of it). Thin budgets: one sample fills one
-  // Ethernet-sized datagram (each datagram costs its headers; smaller samples
-  // paid them more often), and the period grows instead (flowBaseMs). And no
-  // sample may exceed one UDP datagram.
+namespace {
+
+/// The largest slice sample's datagram, its RTPS headers included: a
+/// kSamplesPerPeriod-th of a period's bytes (one sample per period as at
+/// first lost up to half of it). Thin budgets: one Ethernet-sized datagram
+/// (each datagram costs its headers; smaller samples paid them more often),
+/// and the period grows instead (flowBaseMs). And no sample may exceed one
+/// UDP datagram.
+size_t sampleDatagramBytes(double kbps) {
   constexpr size_t kDatagram = 60000;
-  return std::clamp<size_t>(bytesPerPeriod(kbps) / kSamplesPerPeriod, kMtuPayload, kDatagram) - overhead(secure);
+  return std::clamp<size_t>(bytesPerPeriod(kbps) / kSamplesPerPeriod, kUdpPayloadInOneFrame, kDatagram);
 }
 
-namespace {
 /// The slice stream's bytes written per second (each then reaches every receiver).
 double streamBytesPerSecond(const TransportConfig& c) {
   return bytesPerSecond(streamKbps(c) * static_cast<double>(receivers(c)));
 }
+
 }  // namespace
 
+size_t maxSampleBytes(double kbps, bool secure) { return sampleDatagramBytes(kbps) - overhead(secure); }
+
 int flowBaseMs(const TransportConfig& c) {
-  const bool secure = c.security.enabled();
-  const double sample = static_cast<double>(maxSampleBytes(c.bandwidth_kbps, secure) + overhead(secure));
+  const double sample = static_cast<double>(sampleDatagramBytes(c.bandwidth_kbps));
   return std::max(kFlowPeriodMs,
                   static_cast<int>(std::ceil(1000.0 * kSamplesPerPeriod * sample / streamBytesPerSecond(c))));
 }
@@ -182,8 +185,7 @@ DomainParticipant* createParticipant(const TransportConfig& c, std::shared_ptr<E
   // lost fragment loses every sample in the datagram. One sample per datagram,
   // and no datagram above an Ethernet MTU where the samples are that small;
   // except with security, whose handshake needs larger ones.
-  const size_t sample = maxSampleBytes(c.bandwidth_kbps, c.security.enabled()) + overhead(c.security.enabled());
-  size_t datagram = std::max(kMtuPayload, sample);
+  size_t datagram = sampleDatagramBytes(c.bandwidth_kbps);
   if (c.security.enabled()) datagram = std::max(datagram, handshakeBytes(c.security));
   transport->maxMessageSize = static_cast<uint32_t>(datagram);
   q.transport().user_transports.push_back(std::make_shared<PacedTransportDescriptor>(transport, std::move(pacer)));
