@@ -159,10 +159,10 @@ bool Agent::sameGrid(const std::string& owner, double grid) {
   return false;
 }
 
-void Agent::onSlice(wire::SliceFeatures&& s, size_t bytes) {
+void Agent::onSlice(wire::SliceFeatures&& s, size_t bytes, uint64_t sequence) {
   const std::string owner = s.agent().to_string();
   if (owner == config_.agent() || !fromKnown(owner, "a slice")) return;
-  const auto got = peers_.receive(s, bytes, Clock::now());
+  const auto got = peers_.receive(s, bytes, sequence, Clock::now());
   if (got.rejection) return reject(owner, got.rejection);
   if (got.completed) board_.mapHeld(owner);
   // Status shows a transfer under way at once, not a second later.
@@ -174,10 +174,10 @@ void Agent::onRequest(wire::ChunkRequest&& r) {
   if (!fromKnown(r.requester().to_string(), "a request")) return;
   const size_t resent = sender_.resends();
   const size_t wanted = sender_.request(r.requester().to_string(), r.version(), r.slices(),
-                                        std::chrono::milliseconds(r.stalled_ms()), Clock::now());
+                                        std::chrono::milliseconds(r.stalled_ms()), Clock::now(), r.received_through());
   log_.debug(r.requester().to_string() + " asked for " + std::to_string(wanted) + " slices; " +
              std::to_string(sender_.queued()) + " queued, " + std::to_string(sender_.resends() - resent) +
-             " of them again (their copies overdue)");
+             " of them again (their copies overdue or lost in its reader)");
 }
 
 void Agent::onClaim(wire::MatchClaim&& c) {

@@ -90,7 +90,7 @@ class Agent {
   bool fromKnown(const std::string& sender, const char* what);
   void reject(const std::string& from, const transport::Rejection& why);
   void onAnnouncement(wire::MapAnnouncement&& a);
-  void onSlice(wire::SliceFeatures&& s, size_t bytes);
+  void onSlice(wire::SliceFeatures&& s, size_t bytes, uint64_t sequence);
   void onRequest(wire::ChunkRequest&& r);
   void onClaim(wire::MatchClaim&& c);
   void onEstimate(wire::TransformEstimate&& e);

@@ -177,8 +177,8 @@ int Agent::run(Signals& signals) {
   h.announcement = [this](wire::MapAnnouncement&& a) {
     post([this, a = std::move(a)]() mutable { onAnnouncement(std::move(a)); });
   };
-  h.slice = [this](wire::SliceFeatures&& s, size_t bytes) {
-    post([this, s = std::move(s), bytes]() mutable { onSlice(std::move(s), bytes); });
+  h.slice = [this](wire::SliceFeatures&& s, size_t bytes, uint64_t sequence) {
+    post([this, s = std::move(s), bytes, sequence]() mutable { onSlice(std::move(s), bytes, sequence); });
   };
   h.request = [this](wire::ChunkRequest&& r) { post([this, r = std::move(r)]() mutable { onRequest(std::move(r)); }); };
   h.claim = [this](wire::MatchClaim&& c) { post([this, c = std::move(c)]() mutable { onClaim(std::move(c)); }); };

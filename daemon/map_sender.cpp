@@ -20,6 +20,7 @@ void MapSender::setOffer(transport::MapOffer offer) {
   queued_.clear();
   next_part_ = 0;
   leaves_at_.clear();
+  written_as_.clear();
   expected_until_.clear();
   informed_.clear();
   queued_since_.reset();
@@ -41,7 +42,7 @@ size_t MapSender::sliceBytes(int slice) const {
 }
 
 size_t MapSender::request(const std::string& requester, uint64_t version, const std::vector<int32_t>& slices,
-                          Clock::duration stalled, Clock::time_point now) {
+                          Clock::duration stalled, Clock::time_point now, uint64_t received_through) {
   if (version != offer_.announcement.version()) return 0;
   informed_.insert(requester);
   std::vector<int> wanted;
@@ -57,18 +58,21 @@ size_t MapSender::request(const std::string& requester, uint64_t version, const 
   // requester may have matched after the slices left, and then the history is
   // on its way to it). A request after the window from a requester that has
   // received nothing for kStallBeforeResend sends again what left long enough
-  // ago, and opens a new window.
+  // ago, and opens a new window. A slice whose last copy the requester's
+  // reader has passed is sent again at once: Fast DDS acknowledged it and then
+  // lost it (a keyed reader that received it out of order now and then never
+  // hands it on), and no window would bring it.
   auto [entry, first] = expected_until_.try_emplace(requester);
   Clock::time_point& until = entry->second;
   const bool may_resend = !first && now >= until && stalled >= kStallBeforeResend;
   size_t resent = 0;
   for (int k : wanted) {
     const auto left = leaves_at_.find(k);
-    if (left != leaves_at_.end()) {
-      if (!may_resend || now < left->second + grace_) continue;
-      ++resent;
-    }
-    if (queued_.insert(k).second) queue_.push_back(k);
+    const bool written = left != leaves_at_.end();
+    if (written && written_as_.at(k) > received_through && (!may_resend || now < left->second + grace_)) continue;
+    if (!queued_.insert(k).second) continue;
+    queue_.push_back(k);
+    resent += written;
   }
   resends_ += resent;
   if (first || resent) {
@@ -90,7 +94,7 @@ bool MapSender::mayStart(size_t matched_readers, size_t alive_peers, Clock::time
   return matched_readers >= alive_peers || now >= *queued_since_ + kMatchWait;
 }
 
-void MapSender::pump(const std::function<bool(const wire::SliceFeatures&)>& publish,
+void MapSender::pump(const std::function<uint64_t(const wire::SliceFeatures&)>& publish,
                      const std::function<size_t(const wire::SliceFeatures&)>& size, Clock::time_point now) {
   // Fed no faster than kbps_ and at most kFeedAhead ahead, the controller's
   // queue of new samples runs dry now and then; only then does it send repairs
@@ -99,12 +103,14 @@ void MapSender::pump(const std::function<bool(const wire::SliceFeatures&)>& publ
     const int k = queue_.front();
     const auto& samples = offer_.samples.at(k);
     const wire::SliceFeatures& sample = samples[next_part_];
-    if (!publish(sample)) return;
+    const uint64_t sequence = publish(sample);
+    if (!sequence) return;
     const size_t bytes = size(sample);
     bytes_sent_ += bytes;
     ++samples_sent_;
     backlog_until_ = std::max(backlog_until_, now) + leaveTime(bytes);
     leaves_at_[k] = backlog_until_;
+    written_as_[k] = sequence;
     if (++next_part_ == samples.size()) {
       next_part_ = 0;
       queue_.pop_front();

@@ -40,12 +40,14 @@ class MapSender {
   uint64_t version() const { return offer_.announcement.version(); }
 
   /// Peer `requester` asked for `slices` (every announced slice when empty) of
-  /// `version`, having received nothing of it for `stalled`. Queues those
-  /// never written, and those written whose copy is overdue at the requester;
-  /// returns how many of them this map has (0 for another version: the
-  /// announcement tells them).
+  /// `version`, having received nothing of it for `stalled` and the writer's
+  /// samples up to sequence number `received_through`. Queues those never
+  /// written, those whose last copy the requester's reader has passed (it was
+  /// lost inside the reader: a reliable reader delivers in order), and those
+  /// whose copy is overdue at the requester; returns how many of them this
+  /// map has (0 for another version: the announcement tells them).
   size_t request(const std::string& requester, uint64_t version, const std::vector<int32_t>& slices,
-                 Clock::duration stalled, Clock::time_point now);
+                 Clock::duration stalled, Clock::time_point now, uint64_t received_through = 0);
 
   /// Peers that asked for slices of the current version hold its
   /// announcement; `forget` one that restarted (it lost it).
@@ -62,9 +64,9 @@ class MapSender {
 
   /// Hands queued parts to `publish` in order, paced at the stream's rate for
   /// new samples and at most kFeedAhead ahead of `now`, until it refuses one
-  /// (the writer is full): the rest goes on later calls. `size` gives a
-  /// sample's bytes on the wire.
-  void pump(const std::function<bool(const wire::SliceFeatures&)>& publish,
+  /// (returns 0: the writer is full): the rest goes on later calls. `publish`
+  /// returns the sample's sequence number; `size` gives its bytes on the wire.
+  void pump(const std::function<uint64_t(const wire::SliceFeatures&)>& publish,
             const std::function<size_t(const wire::SliceFeatures&)>& size, Clock::time_point now);
 
   size_t queued() const { return queue_.size(); }
@@ -84,7 +86,7 @@ class MapSender {
   /// one gap holds back what follows), and a window includes it.
   static constexpr double kRepairRounds = 10;
   static constexpr Clock::duration kStallBeforeResend = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(kRepairRounds * transport::kSliceHeartbeatS));
+      std::chrono::duration<double>(kRepairRounds * transport::kHeartbeatS));
   /// Share of the stream's rate kept free of new samples, for RTPS repairs
   /// and for the history a late reader gets: the flow controller serves those
   /// only when no new sample waits, and a reader delivers in order, so a
@@ -106,6 +108,7 @@ class MapSender {
   /// and when each written slice's last copy leaves it.
   Clock::time_point backlog_until_{};
   std::map<int, Clock::time_point> leaves_at_;
+  std::map<int, uint64_t> written_as_;  ///< sequence number of each written slice's last part
   /// Per requester: until when copies already written may still be on their
   /// way to it (a late reader gets the history after the backlog).
   std::map<std::string, Clock::time_point> expected_until_;

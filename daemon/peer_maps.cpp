@@ -26,6 +26,8 @@ wire::ChunkRequest PeerMaps::requestFor(const std::string& owner, const Peer& p,
   r.version(p.incoming->announcement().version());
   const auto quiet = std::chrono::duration_cast<std::chrono::milliseconds>(now - p.last_progress).count();
   r.stalled_ms(static_cast<uint32_t>(std::clamp<int64_t>(quiet, 0, UINT32_MAX)));
+  const auto through = received_through_.find(owner);
+  r.received_through(through == received_through_.end() ? 0 : through->second);
   if (!everything) r.slices(p.incoming->missing());  // else an empty list: everything
   return r;
 }
@@ -66,11 +68,12 @@ bool PeerMaps::tally(Peer& p, size_t bytes, Clock::time_point now) {
   return first;
 }
 
-void PeerMaps::holdEarly(const std::string& owner, const wire::SliceFeatures& s, size_t bytes, Clock::time_point now) {
+void PeerMaps::holdEarly(const std::string& owner, const wire::SliceFeatures& s, size_t bytes, uint64_t sequence,
+                         Clock::time_point now) {
   Early& e = early_[owner];
   if (e.version != s.version() || now - e.since > kEarlyHold) e = Early{s.version(), now, {}, 0};  // one version, fresh
   if (e.bytes + bytes > memory_budget_) return;  // the owner's budget holds for these too
-  e.samples.emplace_back(s, bytes);
+  e.samples.push_back({s, bytes, sequence});
   e.bytes += bytes;
 }
 
@@ -78,7 +81,9 @@ size_t PeerMaps::takeEarly(const std::string& owner, Peer& p, Clock::time_point 
   const auto it = early_.find(owner);
   if (it == early_.end() || it->second.version != p.incoming->announcement().version()) return 0;
   size_t taken = 0;
-  for (const auto& [s, bytes] : it->second.samples) {
+  uint64_t& through = received_through_[owner];
+  for (const auto& [s, bytes, sequence] : it->second.samples) {
+    through = std::max(through, sequence);
     if (p.incoming->accept(s)) continue;  // checked as any sample is: a bad one is simply not taken
     tally(p, bytes, now);
     ++taken;
@@ -88,12 +93,16 @@ size_t PeerMaps::takeEarly(const std::string& owner, Peer& p, Clock::time_point 
   return taken;
 }
 
-PeerMaps::Received PeerMaps::receive(const wire::SliceFeatures& s, size_t bytes, Clock::time_point now) {
-  const auto it = peers_.find(s.agent().to_string());
+PeerMaps::Received PeerMaps::receive(const wire::SliceFeatures& s, size_t bytes, uint64_t sequence,
+                                     Clock::time_point now) {
+  const std::string owner = s.agent().to_string();
+  const auto it = peers_.find(owner);
   if (it == peers_.end() || !it->second.incoming || it->second.incoming->announcement().version() != s.version()) {
-    holdEarly(s.agent().to_string(), s, bytes, now);  // its announcement may still be on the way
+    holdEarly(owner, s, bytes, sequence, now);  // its announcement may still be on the way
     return {};
   }
+  uint64_t& through = received_through_[owner];
+  through = std::max(through, sequence);
   Peer& p = it->second;
   if (p.features) return {};  // complete already: a resend meant for another peer
   Received out;
@@ -144,6 +153,7 @@ std::optional<uint64_t> PeerMaps::version(const std::string& peer) const {
 }
 
 bool PeerMaps::setAlive(const std::string& peer, bool alive) {
+  received_through_.erase(peer);
   return alive ? alive_.insert(peer).second : alive_.erase(peer) > 0;
 }
 

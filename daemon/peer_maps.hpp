@@ -40,10 +40,11 @@ class PeerMaps {
     bool completed = false;  ///< this sample completed the map: features() holds it now
     bool first = false;      ///< the first sample of this version
   };
-  /// A slice sample from its owner (`bytes` on the wire). Samples of a version
-  /// not announced yet are held until it is (early()); samples of maps
-  /// already complete are ignored.
-  Received receive(const wire::SliceFeatures& s, size_t bytes, Clock::time_point now);
+  /// A slice sample from its owner (`bytes` on the wire, `sequence` its
+  /// number in the owner's slice writer's stream). Samples of a version not
+  /// announced yet are held until it is (holdEarly); samples of maps already
+  /// complete are ignored.
+  Received receive(const wire::SliceFeatures& s, size_t bytes, uint64_t sequence, Clock::time_point now);
 
   /// Requests for the maps still incomplete that have made no progress for
   /// `interval` (all of them when `at_once`). Each request without progress
@@ -56,7 +57,9 @@ class PeerMaps {
   /// The latest version `peer` announced, held or not.
   std::optional<uint64_t> version(const std::string& peer) const;
 
-  /// Discovery: a peer's participant came (true) or went; returns whether that changed anything.
+  /// Discovery: a peer's participant came (true) or went; returns whether
+  /// that changed anything. Either way its writer's sequence numbers start
+  /// anew (a restarted peer has a new participant).
   bool setAlive(const std::string& peer, bool alive);
   size_t aliveCount() const { return alive_.size(); }
   const std::set<std::string>& alive() const { return alive_; }
@@ -67,8 +70,14 @@ class PeerMaps {
   void retain(Keep keep) {
     for (auto it = peers_.begin(); it != peers_.end();) it = keep(it->first) ? std::next(it) : peers_.erase(it);
     for (auto it = early_.begin(); it != early_.end();) it = keep(it->first) ? std::next(it) : early_.erase(it);
+    for (auto it = received_through_.begin(); it != received_through_.end();)
+      it = keep(it->first) ? std::next(it) : received_through_.erase(it);
   }
-  void clearAlive() { alive_.clear(); }
+  /// Every peer gone (this agent left the network): sequence numbers start anew too.
+  void clearAlive() {
+    alive_.clear();
+    received_through_.clear();
+  }
 
   /// Progress over every peer: maps complete, slices received and announced.
   struct Totals {
@@ -102,14 +111,20 @@ class PeerMaps {
   /// a long stall. Held per owner for one version, up to the memory budget.
   struct Early {
     uint64_t version = 0;
-    Clock::time_point since{};                                    ///< first sample held
-    std::vector<std::pair<wire::SliceFeatures, size_t>> samples;  ///< with their bytes on the wire
+    Clock::time_point since{};  ///< first sample held
+    struct Held {
+      wire::SliceFeatures sample;
+      size_t bytes = 0;       ///< on the wire
+      uint64_t sequence = 0;  ///< in the owner's slice writer's stream
+    };
+    std::vector<Held> samples;
     size_t bytes = 0;
   };
   /// Counts an accepted sample of `bytes` as progress; returns whether it is the version's first.
   static bool tally(Peer& p, size_t bytes, Clock::time_point now);
   /// Holds a sample of an unannounced version of `owner`'s map.
-  void holdEarly(const std::string& owner, const wire::SliceFeatures& s, size_t bytes, Clock::time_point now);
+  void holdEarly(const std::string& owner, const wire::SliceFeatures& s, size_t bytes, uint64_t sequence,
+                 Clock::time_point now);
   /// Takes in the held samples of the version just announced; returns how many.
   size_t takeEarly(const std::string& owner, Peer& p, Clock::time_point now);
   /// Builds a peer's map once every slice is in, and records the transfer.
@@ -125,6 +140,9 @@ class PeerMaps {
   size_t memory_budget_;
   std::map<std::string, Peer> peers_;
   std::map<std::string, Early> early_;
+  /// Per owner, the highest sequence number of its slice writer among the
+  /// samples taken in (wire::ChunkRequest::received_through).
+  std::map<std::string, uint64_t> received_through_;
   std::map<std::string, std::deque<Transfer>> transfers_;  ///< finished transfers per peer, latest last
   std::set<std::string> alive_;
   std::map<std::string, uint64_t> last_seen_ms_;

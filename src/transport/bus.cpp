@@ -1,5 +1,7 @@
 #include "bus.hpp"
 
+#include <fastdds/rtps/common/WriteParams.h>
+
 #include <algorithm>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -42,7 +44,8 @@ std::string claimedSender(const wire::TransformEstimate& e) { return e.computed_
 template <typename T>
 class Listener : public DataReaderListener {
  public:
-  Listener(const SenderDirectory& senders, std::function<void(T&&)> on, const BusHandlers& h)
+  /// `on` gets each sample and its sequence number in its writer's stream.
+  Listener(const SenderDirectory& senders, std::function<void(T&&, uint64_t)> on, const BusHandlers& h)
       : senders_(senders), on_(std::move(on)), impostor_(h.impostor) {}
   void on_data_available(DataReader* reader) override {
     T sample;
@@ -55,13 +58,13 @@ class Listener : public DataReaderListener {
         if (impostor_) impostor_(claimed, sender.value_or(""));
         continue;
       }
-      if (on_) on_(std::move(sample));
+      if (on_) on_(std::move(sample), info.sample_identity.sequence_number().to64long());
     }
   }
 
  private:
   const SenderDirectory& senders_;
-  std::function<void(T&&)> on_;
+  std::function<void(T&&, uint64_t)> on_;
   std::function<void(const std::string&, const std::string&)> impostor_;
 };
 
@@ -136,6 +139,13 @@ class ParticipantWatch : public DomainParticipantListener {
   std::function<void(const std::string&, const std::string&)> refused_;
 };
 
+/// A handler of samples that has no use for their sequence numbers.
+template <typename T>
+std::function<void(T&&, uint64_t)> bySample(std::function<void(T&&)> on) {
+  if (!on) return {};
+  return [on = std::move(on)](T&& sample, uint64_t) { on(std::move(sample)); };
+}
+
 /// QoS shared by the small control topics.
 struct TopicQos {
   bool transient_local = false;
@@ -164,6 +174,10 @@ EndpointQos endpointQos(EndpointQos q, const TopicQos& t) {
 DataWriterQos writerQos(const TopicQos& t) {
   DataWriterQos q = endpointQos(DATAWRITER_QOS_DEFAULT, t);
   q.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(0, 200000000);
+  // Repairs follow heartbeats (every 3 s by default): ask often, so a lost
+  // sample is sent again within a second or two. With 10 % loss an estimate
+  // lost on its way took 6 s more to reach one of two peers with the default.
+  q.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(kHeartbeatS);
   return q;
 }
 
@@ -188,7 +202,7 @@ struct Bus::Impl {
   DataWriter *announcements = nullptr, *slices = nullptr, *requests = nullptr, *claims = nullptr, *estimates = nullptr;
 
   template <typename PubSub, typename T>
-  DataWriter* addTopic(const std::string& name, const TopicQos& tq, std::function<void(T&&)> on,
+  DataWriter* addTopic(const std::string& name, const TopicQos& tq, std::function<void(T&&, uint64_t)> on,
                        bool flow_controlled = false) {
     TypeSupport type(new PubSub());
     if (type.register_type(participant) != ReturnCode_t::RETCODE_OK)
@@ -199,9 +213,6 @@ struct Bus::Impl {
     if (flow_controlled) {
       wq.publish_mode().kind = ASYNCHRONOUS_PUBLISH_MODE;
       wq.publish_mode().flow_controller_name = kFlowControllerName;
-      // Repairs follow heartbeats (every 3 s by default): ask often, so a lost
-      // sample is sent again within a fraction of a second.
-      wq.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(kSliceHeartbeatS);
       // A reader repeats its negative acknowledgement with every heartbeat
       // until the repair arrives; with a link delay and a queue in front of
       // the repair, each repeat sent the sample again (10 % loss and 50 ms
@@ -232,22 +243,22 @@ Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<
     if (!i.publisher || !i.subscriber) throw std::runtime_error("cannot create publisher/subscriber");
     // Announcements and estimates: one per agent / pair, kept for late joiners.
     i.announcements = i.addTopic<wire::MapAnnouncementPubSubType, wire::MapAnnouncement>(
-        "tomomap/announcements", {true, false, 1, 0, 256}, h.announcement);
+        "tomomap/announcements", {true, false, 1, 0, 256}, bySample(h.announcement));
     i.slices = i.addTopic<wire::SliceFeaturesPubSubType, wire::SliceFeatures>(
         "tomomap/slices", {true, false, 1, 0, kSliceInstances},
-        [on = h.slice](wire::SliceFeatures&& s) {
+        [on = h.slice](wire::SliceFeatures&& s, uint64_t sequence) {
           const size_t bytes = serializedSize(s);
-          if (on) on(std::move(s), bytes);
+          if (on) on(std::move(s), bytes, sequence);
         },
         /*flow_controlled=*/true);
     // Requests: best effort, since a receiver repeats them while it lacks
     // something, and a reliable one delivered after a dropout was stale.
     i.requests = i.addTopic<wire::ChunkRequestPubSubType, wire::ChunkRequest>(
-        "tomomap/requests", {false, true, 1, 256, 1, true}, h.request);
-    i.claims =
-        i.addTopic<wire::MatchClaimPubSubType, wire::MatchClaim>("tomomap/claims", {false, false, 1, 0, 1024}, h.claim);
+        "tomomap/requests", {false, true, 1, 256, 1, true}, bySample(h.request));
+    i.claims = i.addTopic<wire::MatchClaimPubSubType, wire::MatchClaim>("tomomap/claims", {false, false, 1, 0, 1024},
+                                                                        bySample(h.claim));
     i.estimates = i.addTopic<wire::TransformEstimatePubSubType, wire::TransformEstimate>(
-        "tomomap/estimates", {true, false, 1, 0, 1024}, h.estimate);
+        "tomomap/estimates", {true, false, 1, 0, 1024}, bySample(h.estimate));
   } catch (...) {
     i.participant->delete_contained_entities();
     DomainParticipantFactory::get_instance()->delete_participant(i.participant);
@@ -265,7 +276,11 @@ Bus::~Bus() {
 bool Bus::publish(const wire::MapAnnouncement& a) {
   return impl_->announcements->write(const_cast<wire::MapAnnouncement*>(&a));
 }
-bool Bus::publish(const wire::SliceFeatures& s) { return impl_->slices->write(const_cast<wire::SliceFeatures*>(&s)); }
+uint64_t Bus::publish(const wire::SliceFeatures& s) {
+  eprosima::fastrtps::rtps::WriteParams params;
+  if (!impl_->slices->write(const_cast<wire::SliceFeatures*>(&s), params)) return 0;
+  return params.sample_identity().sequence_number().to64long();
+}
 bool Bus::publish(const wire::ChunkRequest& r) { return impl_->requests->write(const_cast<wire::ChunkRequest*>(&r)); }
 bool Bus::publish(const wire::MatchClaim& c) { return impl_->claims->write(const_cast<wire::MatchClaim*>(&c)); }
 bool Bus::publish(const wire::TransformEstimate& e) {

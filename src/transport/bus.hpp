@@ -10,14 +10,16 @@
 
 namespace tomomap::transport {
 
-/// The slice writer's heartbeat period [s]: a lost sample is asked for again
+/// Every writer's heartbeat period [s]: a lost sample is asked for again
 /// after the next heartbeat, so a repair takes about one period per attempt.
-constexpr double kSliceHeartbeatS = 1.0;
+/// Fast DDS sends periodic heartbeats only while a sample is unacknowledged.
+constexpr double kHeartbeatS = 1.0;
 
 struct BusHandlers {
   std::function<void(wire::MapAnnouncement&&)> announcement;
-  /// `bytes`: serialised size of the sample, for transfer accounting.
-  std::function<void(wire::SliceFeatures&&, size_t bytes)> slice;
+  /// `bytes`: serialised size of the sample, for transfer accounting;
+  /// `sequence`: its sequence number in its writer's stream.
+  std::function<void(wire::SliceFeatures&&, size_t bytes, uint64_t sequence)> slice;
   std::function<void(wire::ChunkRequest&&)> request;
   std::function<void(wire::MatchClaim&&)> claim;
   std::function<void(wire::TransformEstimate&&)> estimate;
@@ -40,9 +42,10 @@ class Bus {
   Bus& operator=(const Bus&) = delete;
 
   bool publish(const wire::MapAnnouncement& a);
-  /// Queues a slice sample behind the flow controller; false if the writer's
-  /// queue stayed full (try again later).
-  bool publish(const wire::SliceFeatures& s);
+  /// Queues a slice sample behind the flow controller; returns its sequence
+  /// number in the slice writer's stream, 0 if the writer's queue stayed full
+  /// (try again later).
+  uint64_t publish(const wire::SliceFeatures& s);
   bool publish(const wire::ChunkRequest& r);
   bool publish(const wire::MatchClaim& c);
   bool publish(const wire::TransformEstimate& e);

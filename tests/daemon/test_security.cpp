@@ -238,6 +238,7 @@ TEST(Identity, AHundredThousandFuzzedSamplesCrashNothingAndLeaveMemoryFlat) {
         r.owner(any(2) ? "alpha" : "zulu");
         r.version(any(0));
         r.stalled_ms(static_cast<uint32_t>(any(0)));
+        r.received_through(any(0));
         for (uint64_t k = any(50); k > 0; --k) r.slices().push_back(static_cast<int32_t>(any(0)));
         fuzzer.bus->publish(r);
         break;

@@ -41,11 +41,12 @@ size_t thousand(const wire::SliceFeatures&) { return 1000; }
 struct Wire {
   std::vector<std::pair<int, int>> sent;  ///< (slice, part)
   size_t room = 1000;                     ///< samples the writer takes before it is full
-  bool publish(const wire::SliceFeatures& s) {
-    if (room == 0) return false;
+  /// Returns the sample's sequence number in the writer's stream (from 1), 0 when full.
+  uint64_t publish(const wire::SliceFeatures& s) {
+    if (room == 0) return 0;
     --room;
     sent.emplace_back(s.slice(), s.part());
-    return true;
+    return sent.size();
   }
   /// `m` hands this wire what it would send at `at`, 1000 bytes a sample.
   void take(MapSender& m, Clock::time_point at) {
@@ -88,6 +89,27 @@ TEST(MapSender, ASliceStillOnItsWayIsNotSentAgain) {
   EXPECT_EQ(m.queued(), 0u);
   m.request("bravo", 9, {1}, kStalled, t0 + 11400ms);
   EXPECT_EQ(m.queued(), 1u);
+}
+
+TEST(MapSender, ASliceTheRequestersReaderHasPassedIsSentAgainAtOnce) {
+  MapSender m(80, 1s);
+  m.setOffer(fakeOffer(3, 2, 9));
+  m.request("bravo", 9, {}, kStalled, t0);
+  Wire w;
+  w.take(m, t0);
+  w.take(m, t0 + 1s);
+  ASSERT_EQ(w.sent.size(), 6u);  // slice 0 is samples 1-2, slice 1 samples 3-4, slice 2 samples 5-6
+  // At 2 s, well within bravo's window, bravo lacks slices 1 and 2 and has
+  // taken samples up to number 5: its reader delivers in order, so slice 1
+  // (last written as 4) will not come; slice 2's last part (6) may.
+  m.request("bravo", 9, {1, 2}, 2s, t0 + 2s, /*received_through=*/5);
+  EXPECT_EQ(m.queued(), 1u);
+  EXPECT_EQ(m.resends(), 1u);
+  w.take(m, t0 + 2s);
+  EXPECT_EQ(w.sent.back(), std::make_pair(1, 1));
+  // The same request again: slice 1's new copy (7, 8) is on its way.
+  m.request("bravo", 9, {1, 2}, 2s, t0 + 2100ms, /*received_through=*/5);
+  EXPECT_EQ(m.queued(), 0u);
 }
 
 TEST(MapSender, AFullWriterHoldsTheRestForTheNextCall) {

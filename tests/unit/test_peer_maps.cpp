@@ -3,6 +3,8 @@
 // dropped and asked for again.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "core/matcher.hpp"
 #include "peer_maps.hpp"
 #include "synth/synth.hpp"
@@ -51,7 +53,7 @@ TEST(PeerMaps, SlicesBeforeTheirAnnouncementAreHeldAndTakenIn) {
   // The first two thirds of bravo's stream arrive before its announcement.
   const size_t early = all.size() * 2 / 3;
   for (size_t i = 0; i < early; ++i) {
-    const auto got = peers.receive(all[i], 1000, t0);
+    const auto got = peers.receive(all[i], 1000, i + 1, t0);
     EXPECT_FALSE(got.rejection);
     EXPECT_FALSE(got.completed);
   }
@@ -61,7 +63,7 @@ TEST(PeerMaps, SlicesBeforeTheirAnnouncementAreHeldAndTakenIn) {
   ASSERT_TRUE(announced.request);
   EXPECT_FALSE(announced.request->slices().empty()) << "asks for what is missing, not everything";
   EXPECT_LT(announced.request->slices().size(), offer.announcement.slices().size());
-  for (size_t i = early; i < all.size(); ++i) peers.receive(all[i], 1000, t0 + 100ms);
+  for (size_t i = early; i < all.size(); ++i) peers.receive(all[i], 1000, i + 1, t0 + 100ms);
   ASSERT_NE(peers.features("bravo"), nullptr) << "the map is complete without any resend";
 }
 
@@ -71,7 +73,7 @@ TEST(PeerMaps, HeldSlicesAreBoundedByThePeerMemoryBudgetAndByTime) {
   const auto all = samplesOf(offer);
   // A budget of three samples' bytes: the rest of the early stream is not held.
   PeerMaps small("alpha", log, 3000);
-  for (const auto& s : all) small.receive(s, 1000, t0);
+  for (const auto& s : all) small.receive(s, 1000, 1, t0);
   const auto a = small.announce(offer.announcement, t0 + 50ms);
   ASSERT_TRUE(a.request);
   EXPECT_GE(asked(*a.request), offer.announcement.slices().size() - 3);
@@ -79,9 +81,34 @@ TEST(PeerMaps, HeldSlicesAreBoundedByThePeerMemoryBudgetAndByTime) {
   // Samples held longer than an announcement can lag are a resend of an old
   // version meant for another peer: dropped.
   PeerMaps late("alpha", log, 256u << 20);
-  for (const auto& s : all) late.receive(s, 1000, t0);
-  late.receive(all.front(), 1000, t0 + 30s);  // restarts the hold
+  for (const auto& s : all) late.receive(s, 1000, 1, t0);
+  late.receive(all.front(), 1000, 1, t0 + 30s);  // restarts the hold
   const auto b = late.announce(offer.announcement, t0 + 30s);
   ASSERT_TRUE(b.request);
   EXPECT_GE(asked(*b.request), offer.announcement.slices().size() - 1);
+}
+
+TEST(PeerMaps, ARequestSaysHowFarTheOwnersStreamWasTaken) {
+  Log log(LogLevel::Error);
+  PeerMaps peers("alpha", log, 256u << 20);
+  const auto& offer = bravoOffer();
+  const auto all = samplesOf(offer);
+  const auto a = peers.announce(offer.announcement, t0);
+  ASSERT_TRUE(a.request);
+  EXPECT_EQ(a.request->received_through(), 0u) << "nothing taken yet";
+  // bravo's writer numbered its samples 1, 2, ...; the reader handed on all
+  // but the fifth (written as number 5), and the last one taken is number 40.
+  for (size_t i = 0; i < 40; ++i)
+    if (i != 4) peers.receive(all[i], 1000, i + 1, t0 + 100ms);
+  const auto due = peers.due(1s, /*at_once=*/true, t0 + 200ms);
+  ASSERT_EQ(due.size(), 1u);
+  EXPECT_EQ(due.front().received_through(), 40u);
+  EXPECT_TRUE(std::count(due.front().slices().begin(), due.front().slices().end(), all[4].slice()))
+      << "the slice of the sample the reader lost is asked for";
+
+  // A peer that comes again has a new writer, numbering from 1.
+  peers.setAlive("bravo", true);
+  const auto again = peers.due(1s, /*at_once=*/true, t0 + 300ms);
+  ASSERT_EQ(again.size(), 1u);
+  EXPECT_EQ(again.front().received_through(), 0u);
 }
