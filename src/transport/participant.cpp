@@ -99,6 +99,13 @@ constexpr int kLeaseS = 60;
 
 namespace {
 
+/// The slice stream's bytes written per second (each then reaches every receiver).
+double streamBytesPerSecond(const TransportConfig& c) {
+  return bytesPerSecond(streamKbps(c) * static_cast<double>(receivers(c)));
+}
+
+}  // namespace
+
 /// The largest slice sample's datagram, its RTPS headers included: a
 /// kSamplesPerPeriod-th of a period's bytes (one sample per period as at
 /// first lost up to half of it). Thin budgets: one Ethernet-sized datagram
@@ -110,17 +117,10 @@ size_t sampleDatagramBytes(double kbps) {
   return std::clamp<size_t>(bytesPerPeriod(kbps) / kSamplesPerPeriod, kUdpPayloadInOneFrame, kDatagram);
 }
 
-/// The slice stream's bytes written per second (each then reaches every receiver).
-double streamBytesPerSecond(const TransportConfig& c) {
-  return bytesPerSecond(streamKbps(c) * static_cast<double>(receivers(c)));
-}
-
-}  // namespace
-
 size_t maxSampleBytes(double kbps, bool secure) { return sampleDatagramBytes(kbps) - overhead(secure); }
 
 int flowBaseMs(const TransportConfig& c) {
-  const double sample = static_cast<double>(sampleDatagramBytes(c.bandwidth_kbps));
+  const double sample = static_cast<double>(maxSampleBytes(c.bandwidth_kbps, c.security.enabled()));
   return std::max(kFlowPeriodMs,
                   static_cast<int>(std::ceil(1000.0 * kSamplesPerPeriod * sample / streamBytesPerSecond(c))));
 }
@@ -128,7 +128,11 @@ int flowBaseMs(const TransportConfig& c) {
 int flowPeriodMs(const TransportConfig& c) { return flowBaseMs(c) * static_cast<int>(receivers(c)); }
 
 size_t flowBytesPerPeriod(const TransportConfig& c) {
-  return static_cast<size_t>(streamBytesPerSecond(c) * flowBaseMs(c) / 1000.0);
+  // The controller counts whole RTPS messages, headers and all: the stream's
+  // payload of a base period, each full sample with its message's headers.
+  const double message_per_payload = static_cast<double>(sampleDatagramBytes(c.bandwidth_kbps)) /
+                                     static_cast<double>(maxSampleBytes(c.bandwidth_kbps, c.security.enabled()));
+  return static_cast<size_t>(streamBytesPerSecond(c) * flowBaseMs(c) / 1000.0 * message_per_payload);
 }
 
 namespace {

@@ -73,12 +73,12 @@ double controlShare(const TransportConfig& c);
 
 /// The budget is total egress, and every slice sample goes to every receiver
 /// (one unicast datagram each), so the slice stream itself may use
-/// (1 - controlShare) / receivers of it [kbit/s]. Receivers are the
-/// configured peers (at least one).
+/// (1 - controlShare) / receivers of it [kbit/s] of samples' serialized
+/// payload. Receivers are the configured peers (at least one).
 double streamKbps(const TransportConfig& c);
 
 /// The flow controller's period [ms] with one receiver: kFlowPeriodMs, or
-/// longer where the stream's bytes in it would hold fewer than
+/// longer where the stream's payload in it would hold fewer than
 /// kSamplesPerPeriod of the largest samples (thin budgets, where a sample is
 /// one Ethernet datagram: at 250 kbit/s with four receivers, samples of
 /// 1.3 kB and 100 ms, one sample fitted where two did not and the stream ran
@@ -90,8 +90,14 @@ int flowBaseMs(const TransportConfig& c);
 /// instead of the bytes per period shrinking (a sample must fit one period's
 /// bytes, and the sample size must not depend on the fleet).
 int flowPeriodMs(const TransportConfig& c);
-/// Bytes of samples the flow controller lets out per period (each then
-/// reaching every receiver): the stream's share of one base period.
+/// Bytes the flow controller lets out per period (each message then reaching
+/// every receiver): the stream's payload of one base period plus the RTPS
+/// headers of the messages that carry it. The controller counts whole
+/// messages; counted as payload, the headers (about 120 bytes a full sample)
+/// and a period's unused rest had it pass only 86 % of the stream, below what
+/// the daemon fed it (MapSender: 85 %), so its queue of new samples never ran
+/// dry and repairs, which it serves only then, waited until the whole map had
+/// left (10 % loss: a reader stuck 16 s behind one lost sample).
 size_t flowBytesPerPeriod(const TransportConfig& c);
 /// The flow controller's name (a static string: Fast DDS keeps the pointer).
 extern const char* const kFlowControllerName;
@@ -106,6 +112,9 @@ size_t bytesPerPeriod(double bandwidth_kbps);
 /// cap just under the budget, beneath the flow controller's share for the
 /// slice stream (EgressPacer).
 double pacedKbps(const TransportConfig& c);
+
+/// The largest slice sample's RTPS message, headers included (one UDP payload).
+size_t sampleDatagramBytes(double bandwidth_kbps);
 
 /// Largest slice sample: a fraction of the per-period budget, so that the
 /// controller, which sends only whole samples per period, fills each period
