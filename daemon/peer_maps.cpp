@@ -11,10 +11,12 @@ namespace {
 
 constexpr size_t kTransfersKept = 8;
 constexpr int kMaxBackoffDoublings = 4;  ///< requests back off to 16 x request_interval_s at most
-/// How long samples of an unannounced version are held: an announcement is
-/// at most a few heartbeats behind its stream; samples older than this are a
-/// resend of an old version meant for another peer.
-constexpr auto kEarlyHold = std::chrono::seconds(10);
+/// How long samples of an unannounced version are held: an announcement can
+/// lag its stream by the time discovery takes on a thin link (five agents at
+/// 250 kbit/s: 20 s; with 10 s the samples held were dropped, and sent again
+/// once asked for), but not by a participant lease (60 s): samples older than
+/// that are a resend of an old version meant for another peer.
+constexpr auto kEarlyHold = std::chrono::seconds(60);
 
 }  // namespace
 

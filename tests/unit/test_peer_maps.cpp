@@ -82,8 +82,8 @@ TEST(PeerMaps, HeldSlicesAreBoundedByThePeerMemoryBudgetAndByTime) {
   // version meant for another peer: dropped.
   PeerMaps late("alpha", log, 256u << 20);
   for (const auto& s : all) late.receive(s, 1000, 1, t0);
-  late.receive(all.front(), 1000, 1, t0 + 30s);  // restarts the hold
-  const auto b = late.announce(offer.announcement, t0 + 30s);
+  late.receive(all.front(), 1000, 1, t0 + 90s);  // restarts the hold
+  const auto b = late.announce(offer.announcement, t0 + 90s);
   ASSERT_TRUE(b.request);
   EXPECT_GE(asked(*b.request), offer.announcement.slices().size() - 1);
 }
