@@ -2,6 +2,16 @@
 
 #include <fastdds/rtps/transport/ChainingTransport.h>
 
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "udp_sender.hpp"
+
 namespace tomomap::transport {
 
 namespace rtps = eprosima::fastdds::rtps;
@@ -10,6 +20,24 @@ using eprosima::fastrtps::rtps::octet;
 using eprosima::fastrtps::rtps::SenderResource;
 
 namespace {
+
+/// A hash of an RTPS message without its send times: the INFO_TS bodies and
+/// the statistics submessage Fast DDS fills in as it sends. Two sends of the
+/// same submessages hash alike.
+size_t identity(const octet* buffer, uint32_t size) {
+  constexpr uint32_t kHeader = 20;
+  constexpr octet kInfoTimestamp = 0x09, kStatistics = 0x80;
+  std::string kept(reinterpret_cast<const char*>(buffer), std::min(size, kHeader));
+  for (uint32_t at = kHeader; at + 4 <= size;) {
+    const octet id = buffer[at], flags = buffer[at + 1];
+    const uint32_t length = (flags & 1) ? buffer[at + 2] | buffer[at + 3] << 8 : buffer[at + 2] << 8 | buffer[at + 3];
+    const uint32_t next = std::min(size, at + 4 + length);
+    if (id != kInfoTimestamp && id != kStatistics) kept.append(reinterpret_cast<const char*>(buffer + at), next - at);
+    if (length == 0 || next == size) break;  // a length of 0 runs to the message's end
+    at = next;
+  }
+  return std::hash<std::string>{}(kept);
+}
 
 /// One destination as the locator range a sender resource takes.
 struct OneLocator : rtps::LocatorsIterator {
@@ -26,32 +54,62 @@ struct OneLocator : rtps::LocatorsIterator {
 
 class PacedTransport : public rtps::ChainingTransport {
  public:
-  explicit PacedTransport(const PacedTransportDescriptor& d) : ChainingTransport(d), descriptor_(d) {}
+  explicit PacedTransport(const PacedTransportDescriptor& d)
+      : ChainingTransport(d), descriptor_(d), own_(d.own_sender ? std::make_unique<UdpSender>() : nullptr) {}
 
   rtps::TransportDescriptorInterface* get_configuration() override { return &descriptor_; }
 
   /// Sends one datagram per destination, each when the pacer finds the link
   /// free. Fast DDS offers every message to each of its sender resources
-  /// (sockets) in turn and only the one whose purpose fits sends it, so only
-  /// what the socket really sent occupies the link (the others' turns still
-  /// wait for the link to be free, which costs no throughput: the next
-  /// datagram would have waited as long). A datagram that cannot
-  /// start before its deadline is dropped, as a full socket would drop it,
-  /// and the protocol repairs it like any loss on the link.
+  /// (sockets) in turn: the first offer sends it, the others are repeats().
+  /// From our own socket the statistics submessage stays behind; through the
+  /// chained transport (the lossy test one) only the resource whose purpose
+  /// fits sends. A datagram that cannot start before its deadline is dropped,
+  /// as a full socket would drop it, and the protocol repairs it like any
+  /// loss on the link.
   bool send(SenderResource* low, const octet* buffer, uint32_t size, rtps::LocatorsIterator* begin,
             rtps::LocatorsIterator* end, const std::chrono::steady_clock::time_point& deadline) override {
     bool sent = false;
+    const size_t message = identity(buffer, size);
     for (auto& it = *begin; it != *end; ++it) {
       if (!low_level_transport_->IsLocatorSupported(*it)) continue;
       const Locator_t destination = *it;
+      if (repeats(message, destination, low)) {
+        sent = true;
+        continue;
+      }
       descriptor_.pacer->send(deadline, [&]() -> size_t {
         OneLocator first(&destination), last(&destination + 1);
-        if (!low->send(buffer, size, &first, &last, deadline)) return 0;
+        const size_t bytes = own_ ? withoutStatistics(buffer, size) : size;
+        if (own_ ? !own_->send(buffer, bytes, destination) : !low->send(buffer, size, &first, &last, deadline))
+          return 0;
         sent = true;
-        return wireBytes(size);
+        remember(message, destination, low);
+        return wireBytes(bytes);
       });
     }
     return sent;
+  }
+
+  /// Whether `message` (identity()) has left for `destination` already:
+  /// offered by another of Fast DDS's sender resources (each gets every
+  /// message in turn; at 250 kbit/s with four receivers one turn took longer
+  /// than 50 ms), or by the same one a moment ago (Fast DDS sent every
+  /// participant announcement twice to each peer, to its initial-peer locator
+  /// and to the one it announced, the same address and port, 2-3 % of an
+  /// agent's bytes with four peers). A repair of a sample is offered again
+  /// only after the 500 ms of negative-acknowledgement suppression.
+  bool repeats(size_t message, const Locator_t& destination, const SenderResource* low) {
+    std::lock_guard<std::mutex> lock(recent_mutex_);
+    const auto now = std::chrono::steady_clock::now();
+    return std::any_of(recent_.begin(), recent_.end(), [&](const Sent& s) {
+      if (s.message != message || !(s.destination == destination)) return false;
+      return now - s.at < (s.low == low ? kRepeatWindow : kOtherResourceWindow);
+    });
+  }
+  void remember(size_t message, const Locator_t& destination, const SenderResource* low) {
+    std::lock_guard<std::mutex> lock(recent_mutex_);
+    recent_[next_++ % recent_.size()] = {message, destination, low, std::chrono::steady_clock::now()};
   }
 
   void receive(rtps::TransportReceiverInterface* next, const octet* buffer, uint32_t size, const Locator_t& local,
@@ -60,14 +118,28 @@ class PacedTransport : public rtps::ChainingTransport {
   }
 
  private:
+  static constexpr std::chrono::milliseconds kRepeatWindow{50};
+  /// Longer than any turn over the sender resources takes: six receivers of
+  /// 1.5 kB datagrams at 64 kbit/s take 1.1 s.
+  static constexpr std::chrono::seconds kOtherResourceWindow{5};
+  struct Sent {
+    size_t message = 0;
+    Locator_t destination;
+    const SenderResource* low = nullptr;
+    std::chrono::steady_clock::time_point at{};
+  };
   PacedTransportDescriptor descriptor_;
+  std::unique_ptr<UdpSender> own_;  ///< null: send through the chained transport
+  std::mutex recent_mutex_;
+  std::array<Sent, 64> recent_{};  ///< the last datagrams sent, by every thread
+  size_t next_ = 0;
 };
 
 }  // namespace
 
 PacedTransportDescriptor::PacedTransportDescriptor(std::shared_ptr<rtps::TransportDescriptorInterface> udp,
-                                                   std::shared_ptr<EgressPacer> p)
-    : ChainingTransportDescriptor(std::move(udp)), pacer(std::move(p)) {}
+                                                   std::shared_ptr<EgressPacer> p, bool own)
+    : ChainingTransportDescriptor(std::move(udp)), pacer(std::move(p)), own_sender(own) {}
 
 rtps::TransportInterface* PacedTransportDescriptor::create_transport() const { return new PacedTransport(*this); }
 

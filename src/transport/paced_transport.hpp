@@ -12,11 +12,15 @@
 namespace tomomap::transport {
 
 struct PacedTransportDescriptor : eprosima::fastdds::rtps::ChainingTransportDescriptor {
+  /// `own_sender`: send from a socket of our own, without the statistics
+  /// submessage (udp_sender.hpp); false to send through `udp` itself (Fast
+  /// DDS's lossy test transport, whose losses happen in its send).
   PacedTransportDescriptor(std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface> udp,
-                           std::shared_ptr<EgressPacer> pacer);
+                           std::shared_ptr<EgressPacer> pacer, bool own_sender);
   eprosima::fastdds::rtps::TransportInterface* create_transport() const override;
 
   std::shared_ptr<EgressPacer> pacer;
+  bool own_sender = true;
 };
 
 }  // namespace tomomap::transport

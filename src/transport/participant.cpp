@@ -192,7 +192,8 @@ DomainParticipant* createParticipant(const TransportConfig& c, std::shared_ptr<E
   size_t datagram = sampleDatagramBytes(c.bandwidth_kbps);
   if (c.security.enabled()) datagram = std::max(datagram, handshakeBytes(c.security));
   transport->maxMessageSize = static_cast<uint32_t>(datagram);
-  q.transport().user_transports.push_back(std::make_shared<PacedTransportDescriptor>(transport, std::move(pacer)));
+  q.transport().user_transports.push_back(
+      std::make_shared<PacedTransportDescriptor>(transport, std::move(pacer), /*own_sender=*/c.test_drop_percent == 0));
 
   auto& builtin = q.wire_protocol().builtin;
   builtin.metatrafficUnicastLocatorList.push_back(udp(c.address, c.discovery_port));
