@@ -91,20 +91,19 @@ class PacedTransport : public rtps::ChainingTransport {
     return sent;
   }
 
-  /// Whether `message` (identity()) has left for `destination` already:
-  /// offered by another of Fast DDS's sender resources (each gets every
-  /// message in turn; at 250 kbit/s with four receivers one turn took longer
-  /// than 50 ms), or by the same one a moment ago (Fast DDS sent every
-  /// participant announcement twice to each peer, to its initial-peer locator
-  /// and to the one it announced, the same address and port, 2-3 % of an
-  /// agent's bytes with four peers). A repair of a sample is offered again
-  /// only after the 500 ms of negative-acknowledgement suppression.
+  /// Whether `message` (identity()) has left for `destination` already,
+  /// offered by another of Fast DDS's sender resources: each gets every
+  /// message in turn, and the first sends it from our socket (at 250 kbit/s
+  /// with four receivers one turn took longer than 50 ms). The same resource
+  /// offering it again is a retry Fast DDS means to send: skipping repeats
+  /// within 50 ms from it too (participant announcements went twice to each
+  /// peer) once kept a peer's first announcement from a participant that had
+  /// just appeared, which then waited 12 s for the next one.
   bool repeats(size_t message, const Locator_t& destination, const SenderResource* low) {
     std::lock_guard<std::mutex> lock(recent_mutex_);
     const auto now = std::chrono::steady_clock::now();
     return std::any_of(recent_.begin(), recent_.end(), [&](const Sent& s) {
-      if (s.message != message || !(s.destination == destination)) return false;
-      return now - s.at < (s.low == low ? kRepeatWindow : kOtherResourceWindow);
+      return s.message == message && s.destination == destination && s.low != low && now - s.at < kOtherResourceWindow;
     });
   }
   void remember(size_t message, const Locator_t& destination, const SenderResource* low) {
@@ -118,7 +117,6 @@ class PacedTransport : public rtps::ChainingTransport {
   }
 
  private:
-  static constexpr std::chrono::milliseconds kRepeatWindow{50};
   /// Longer than any turn over the sender resources takes: six receivers of
   /// 1.5 kB datagrams at 64 kbit/s take 1.1 s.
   static constexpr std::chrono::seconds kOtherResourceWindow{5};
