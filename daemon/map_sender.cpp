@@ -19,8 +19,7 @@ void MapSender::setOffer(transport::MapOffer offer) {
   queue_.clear();
   queued_.clear();
   next_part_ = 0;
-  leaves_at_.clear();
-  written_as_.clear();
+  written_.clear();
   expected_until_.clear();
   informed_.clear();
   queued_since_.reset();
@@ -67,9 +66,10 @@ size_t MapSender::request(const std::string& requester, uint64_t version, const 
   const bool may_resend = !first && now >= until && stalled >= kStallBeforeResend;
   size_t resent = 0;
   for (int k : wanted) {
-    const auto left = leaves_at_.find(k);
-    const bool written = left != leaves_at_.end();
-    if (written && written_as_.at(k) > received_through && (!may_resend || now < left->second + grace_)) continue;
+    const auto copy = written_.find(k);
+    const bool written = copy != written_.end();
+    if (written && copy->second.sequence > received_through && (!may_resend || now < copy->second.leaves + grace_))
+      continue;
     if (!queued_.insert(k).second) continue;
     queue_.push_back(k);
     resent += written;
@@ -109,8 +109,7 @@ void MapSender::pump(const std::function<uint64_t(const wire::SliceFeatures&)>& 
     bytes_sent_ += bytes;
     ++samples_sent_;
     backlog_until_ = std::max(backlog_until_, now) + leaveTime(bytes);
-    leaves_at_[k] = backlog_until_;
-    written_as_[k] = sequence;
+    written_[k] = {backlog_until_, sequence};
     if (++next_part_ == samples.size()) {
       next_part_ = 0;
       queue_.pop_front();

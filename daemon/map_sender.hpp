@@ -107,8 +107,11 @@ class MapSender {
   /// When the flow controller will have sent everything handed to it so far,
   /// and when each written slice's last copy leaves it.
   Clock::time_point backlog_until_{};
-  std::map<int, Clock::time_point> leaves_at_;
-  std::map<int, uint64_t> written_as_;  ///< sequence number of each written slice's last part
+  struct Written {
+    Clock::time_point leaves{};  ///< when its last copy leaves the controller
+    uint64_t sequence = 0;       ///< the writer's sequence number of its last part
+  };
+  std::map<int, Written> written_;
   /// Per requester: until when copies already written may still be on their
   /// way to it (a late reader gets the history after the backlog).
   std::map<std::string, Clock::time_point> expected_until_;

@@ -61,6 +61,11 @@ PeerMaps::Announced PeerMaps::announce(wire::MapAnnouncement a, Clock::time_poin
   return out;
 }
 
+void PeerMaps::noteTaken(const std::string& owner, uint64_t sequence) {
+  uint64_t& through = received_through_[owner];
+  through = std::max(through, sequence);
+}
+
 bool PeerMaps::tally(Peer& p, size_t bytes, Clock::time_point now) {
   const bool first = p.samples++ == 0;
   if (first) p.first_slice = now;
@@ -83,9 +88,8 @@ size_t PeerMaps::takeEarly(const std::string& owner, Peer& p, Clock::time_point 
   const auto it = early_.find(owner);
   if (it == early_.end() || it->second.version != p.incoming->announcement().version()) return 0;
   size_t taken = 0;
-  uint64_t& through = received_through_[owner];
   for (const auto& [s, bytes, sequence] : it->second.samples) {
-    through = std::max(through, sequence);
+    noteTaken(owner, sequence);
     if (p.incoming->accept(s)) continue;  // checked as any sample is: a bad one is simply not taken
     tally(p, bytes, now);
     ++taken;
@@ -103,8 +107,7 @@ PeerMaps::Received PeerMaps::receive(const wire::SliceFeatures& s, size_t bytes,
     holdEarly(owner, s, bytes, sequence, now);  // its announcement may still be on the way
     return {};
   }
-  uint64_t& through = received_through_[owner];
-  through = std::max(through, sequence);
+  noteTaken(owner, sequence);
   Peer& p = it->second;
   if (p.features) return {};  // complete already: a resend meant for another peer
   Received out;

@@ -120,6 +120,8 @@ class PeerMaps {
     std::vector<Held> samples;
     size_t bytes = 0;
   };
+  /// `owner`'s sample numbered `sequence` was taken in (received_through_).
+  void noteTaken(const std::string& owner, uint64_t sequence);
   /// Counts an accepted sample of `bytes` as progress; returns whether it is the version's first.
   static bool tally(Peer& p, size_t bytes, Clock::time_point now);
   /// Holds a sample of an unannounced version of `owner`'s map.

@@ -8,7 +8,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
-#include <string>
+#include <string_view>
 
 #include "udp_sender.hpp"
 
@@ -20,24 +20,6 @@ using eprosima::fastrtps::rtps::octet;
 using eprosima::fastrtps::rtps::SenderResource;
 
 namespace {
-
-/// A hash of an RTPS message without its send times: the INFO_TS bodies and
-/// the statistics submessage Fast DDS fills in as it sends. Two sends of the
-/// same submessages hash alike.
-size_t identity(const octet* buffer, uint32_t size) {
-  constexpr uint32_t kHeader = 20;
-  constexpr octet kInfoTimestamp = 0x09, kStatistics = 0x80;
-  std::string kept(reinterpret_cast<const char*>(buffer), std::min(size, kHeader));
-  for (uint32_t at = kHeader; at + 4 <= size;) {
-    const octet id = buffer[at], flags = buffer[at + 1];
-    const uint32_t length = (flags & 1) ? buffer[at + 2] | buffer[at + 3] << 8 : buffer[at + 2] << 8 | buffer[at + 3];
-    const uint32_t next = std::min(size, at + 4 + length);
-    if (id != kInfoTimestamp && id != kStatistics) kept.append(reinterpret_cast<const char*>(buffer + at), next - at);
-    if (length == 0 || next == size) break;  // a length of 0 runs to the message's end
-    at = next;
-  }
-  return std::hash<std::string>{}(kept);
-}
 
 /// One destination as the locator range a sender resource takes.
 struct OneLocator : rtps::LocatorsIterator {
@@ -70,7 +52,10 @@ class PacedTransport : public rtps::ChainingTransport {
   bool send(SenderResource* low, const octet* buffer, uint32_t size, rtps::LocatorsIterator* begin,
             rtps::LocatorsIterator* end, const std::chrono::steady_clock::time_point& deadline) override {
     bool sent = false;
-    const size_t message = identity(buffer, size);
+    // What leaves our socket, and what identifies the message among the
+    // resources' offers (the statistics a chained send fills in excluded).
+    const size_t bytes = withoutStatistics(buffer, size);
+    const size_t message = std::hash<std::string_view>{}({reinterpret_cast<const char*>(buffer), bytes});
     for (auto& it = *begin; it != *end; ++it) {
       if (!low_level_transport_->IsLocatorSupported(*it)) continue;
       const Locator_t destination = *it;
@@ -80,18 +65,17 @@ class PacedTransport : public rtps::ChainingTransport {
       }
       descriptor_.pacer->send(deadline, [&]() -> size_t {
         OneLocator first(&destination), last(&destination + 1);
-        const size_t bytes = own_ ? withoutStatistics(buffer, size) : size;
         if (own_ ? !own_->send(buffer, bytes, destination) : !low->send(buffer, size, &first, &last, deadline))
           return 0;
         sent = true;
         remember(message, destination, low);
-        return wireBytes(bytes);
+        return wireBytes(own_ ? bytes : size);
       });
     }
     return sent;
   }
 
-  /// Whether `message` (identity()) has left for `destination` already,
+  /// Whether `message` (a hash of its bytes) has left for `destination` already,
   /// offered by another of Fast DDS's sender resources: each gets every
   /// message in turn, and the first sends it from our socket (at 250 kbit/s
   /// with four receivers one turn took longer than 50 ms). The same resource

@@ -240,8 +240,7 @@ TEST(SliceCodec, EveryFlowPeriodHoldsSeveralOfTheLargestSamples) {
       TransportConfig c;
       c.bandwidth_kbps = kbps;
       c.peers.resize(peers);
-      // The controller counts whole messages: a period holds eight of the
-      // largest, headers and all.
+      // A period holds eight of the largest messages, headers and all.
       const double per_period = static_cast<double>(flowBytesPerPeriod(c));
       EXPECT_GE(per_period, kSamplesPerPeriod * sampleDatagramBytes(kbps)) << kbps << " " << peers;
       EXPECT_GE(flowBaseMs(c), kFlowPeriodMs);
