@@ -1,5 +1,6 @@
 #include "hamming.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 #if defined(__x86_64__) && defined(__GNUC__)
@@ -40,67 +41,75 @@ Nearest nearestScalar(const cv::Mat& a, const cv::Mat& b) {
 }
 
 #ifdef TOMOMAP_HAVE_AVX512_PATH
-/// The same scan, eight b descriptors at a time (AVX-512 with VPOPCNTDQ:
-/// 5-6x the scalar loop). b is laid out word-major in blocks of eight so one
-/// load brings the same word of eight descriptors; lanes past the end of b
-/// read as the farthest possible distance. Ties resolve as in the scalar
-/// scan: each lane keeps its first nearest j, and the lowest such j among the
-/// lanes at the minimum wins; b's nearest i only moves on a strictly smaller distance.
+/// The same scan, sixteen b descriptors against four a descriptors at a time
+/// (AVX-512 with VPOPCNTDQ). b is laid out word-major in blocks of sixteen
+/// 32-bit lanes, so one load brings the same word of sixteen descriptors and
+/// serves four rows of a. Each distance travels with its index as one key,
+/// distance << kIndexBits | index: the smallest key is the nearest neighbour
+/// with the lowest index, the scalar scan's tie rule both ways, and one
+/// unsigned min keeps it. Lanes past the end of b hold the largest key; rows
+/// past the end of a repeat a's last row, whose keys change no minimum.
+constexpr int kIndexBits = 23;  ///< indices below 8 M; distances (at most 256) take the 9 bits above
+
 __attribute__((target("avx512f,avx512vpopcntdq"))) Nearest nearestAvx512(const cv::Mat& a, const cv::Mat& b) {
-  const int na = a.rows, nb = b.rows, blocks = (nb + 7) / 8;
-  const std::vector<uint64_t> wa = descriptorWords(a);
-  std::vector<uint64_t> wb(static_cast<size_t>(blocks) * 32, 0);
+  constexpr int kLanes = 16, kRows = 4, kWords = 8;
+  // Every lane, through the zero-masking forms: GCC 12's unmasked shift and min
+  // warn of an uninitialised temporary.
+  constexpr __mmask16 kAll = 0xFFFF;
+  CV_Assert(a.rows < (1 << kIndexBits) && b.rows < (1 << kIndexBits));
+  const int na = a.rows, nb = b.rows, blocks = (nb + kLanes - 1) / kLanes;
+  std::vector<uint32_t> wb(static_cast<size_t>(blocks) * kLanes * kWords, 0);
   for (int j = 0; j < nb; ++j)
-    for (int w = 0; w < 4; ++w) {
-      uint64_t v;
-      std::memcpy(&v, b.ptr(j) + 8 * w, 8);
-      wb[static_cast<size_t>((j / 8) * 32 + w * 8 + j % 8)] = v;
+    for (int w = 0; w < kWords; ++w)
+      std::memcpy(&wb[static_cast<size_t>((j / kLanes) * kLanes * kWords + w * kLanes + j % kLanes)], b.ptr(j) + 4 * w,
+                  4);
+  std::vector<uint32_t> key_b(static_cast<size_t>(blocks) * kLanes, UINT32_MAX);
+  Nearest n{std::vector<int>(static_cast<size_t>(na), -1), std::vector<int>(static_cast<size_t>(nb), -1)};
+  const __mmask16 last_valid = static_cast<__mmask16>(nb % kLanes == 0 ? 0xFFFF : (1u << (nb % kLanes)) - 1);
+  const __m512i none = _mm512_set1_epi32(-1),
+                lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  for (int i0 = 0; i0 < na; i0 += kRows) {
+    uint32_t x[kRows][kWords];
+    __m512i row_index[kRows], best[kRows];
+#pragma GCC unroll 4
+    for (int r = 0; r < kRows; ++r) {
+      const int i = std::min(i0 + r, na - 1);
+      std::memcpy(x[r], a.ptr(i), sizeof x[r]);
+      row_index[r] = _mm512_set1_epi32(i);
+      best[r] = none;
     }
-  std::vector<uint64_t> dist_b(static_cast<size_t>(blocks) * 8, UINT64_MAX);
-  std::vector<int64_t> best_b(static_cast<size_t>(blocks) * 8, -1);
-  Nearest n{std::vector<int>(static_cast<size_t>(na), -1), {}};
-  const __mmask8 last_valid = static_cast<__mmask8>((nb % 8 == 0) ? 0xFF : ((1u << (nb % 8)) - 1));
-  const __m512i farthest = _mm512_set1_epi64(1024), lane = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
-  for (int i = 0; i < na; ++i) {
-    const uint64_t* x = &wa[static_cast<size_t>(i) * 4];
-    const __m512i x0 = _mm512_set1_epi64(static_cast<long long>(x[0])),
-                  x1 = _mm512_set1_epi64(static_cast<long long>(x[1])),
-                  x2 = _mm512_set1_epi64(static_cast<long long>(x[2])),
-                  x3 = _mm512_set1_epi64(static_cast<long long>(x[3]));
-    const __m512i self = _mm512_set1_epi64(i);
-    __m512i best = farthest, best_j = _mm512_set1_epi64(-1);
     for (int k = 0; k < blocks; ++k) {
-      const uint64_t* y = &wb[static_cast<size_t>(k) * 32];
-      __m512i d =
-          _mm512_add_epi64(_mm512_add_epi64(_mm512_popcnt_epi64(_mm512_xor_si512(x0, _mm512_loadu_si512(y))),
-                                            _mm512_popcnt_epi64(_mm512_xor_si512(x1, _mm512_loadu_si512(y + 8)))),
-                           _mm512_add_epi64(_mm512_popcnt_epi64(_mm512_xor_si512(x2, _mm512_loadu_si512(y + 16))),
-                                            _mm512_popcnt_epi64(_mm512_xor_si512(x3, _mm512_loadu_si512(y + 24)))));
-      if (k == blocks - 1) d = _mm512_mask_mov_epi64(farthest, last_valid, d);
-      const __m512i j = _mm512_add_epi64(_mm512_set1_epi64(8LL * k), lane);
-      const __mmask8 closer = _mm512_cmplt_epu64_mask(d, best);
-      best = _mm512_mask_mov_epi64(best, closer, d);
-      best_j = _mm512_mask_mov_epi64(best_j, closer, j);
-      uint64_t* db = &dist_b[static_cast<size_t>(k) * 8];
-      const __mmask8 nearer_b = _mm512_cmplt_epu64_mask(d, _mm512_loadu_si512(db));
-      _mm512_mask_storeu_epi64(db, nearer_b, d);
-      _mm512_mask_storeu_epi64(&best_b[static_cast<size_t>(k) * 8], nearer_b, self);
-    }
-    // Eight lanes reduced by hand (GCC 12's reduce intrinsics warn of an uninitialised temporary).
-    alignas(64) uint64_t lane_best[8];
-    alignas(64) int64_t lane_j[8];
-    _mm512_store_si512(lane_best, best);
-    _mm512_store_si512(lane_j, best_j);
-    uint64_t m = 1024;
-    int64_t first_j = -1;
-    for (int l = 0; l < 8; ++l)
-      if (lane_best[l] < m || (lane_best[l] == m && m < 1024 && lane_j[l] < first_j)) {
-        m = lane_best[l];
-        first_j = lane_j[l];
+      const uint32_t* y = &wb[static_cast<size_t>(k) * kLanes * kWords];
+      __m512i yw[kWords];
+#pragma GCC unroll 8
+      for (int w = 0; w < kWords; ++w) yw[w] = _mm512_loadu_si512(y + w * kLanes);
+      const __m512i j = _mm512_add_epi32(_mm512_set1_epi32(kLanes * k), lane);
+      uint32_t* kb = &key_b[static_cast<size_t>(k) * kLanes];
+      __m512i nearest_b = _mm512_loadu_si512(kb);
+#pragma GCC unroll 4
+      for (int r = 0; r < kRows; ++r) {
+        __m512i d = _mm512_popcnt_epi32(_mm512_xor_si512(yw[0], _mm512_set1_epi32(static_cast<int>(x[r][0]))));
+#pragma GCC unroll 8
+        for (int w = 1; w < kWords; ++w)
+          d = _mm512_add_epi32(
+              d, _mm512_popcnt_epi32(_mm512_xor_si512(yw[w], _mm512_set1_epi32(static_cast<int>(x[r][w])))));
+        d = _mm512_maskz_slli_epi32(kAll, d, kIndexBits);
+        const __m512i key_a = k == blocks - 1 ? _mm512_mask_or_epi32(none, last_valid, d, j) : _mm512_or_si512(d, j);
+        best[r] = _mm512_maskz_min_epu32(kAll, best[r], key_a);
+        nearest_b = _mm512_maskz_min_epu32(kAll, nearest_b, _mm512_or_si512(d, row_index[r]));
       }
-    n.best_a[static_cast<size_t>(i)] = static_cast<int>(first_j);
+      _mm512_storeu_si512(kb, nearest_b);
+    }
+    for (int r = 0; r < kRows && i0 + r < na; ++r) {
+      // Sixteen lanes reduced by hand (GCC 12's reduce intrinsics warn of an uninitialised temporary).
+      alignas(64) uint32_t keys[kLanes];
+      _mm512_store_si512(keys, best[r]);
+      const uint32_t m = *std::min_element(keys, keys + kLanes);
+      n.best_a[static_cast<size_t>(i0 + r)] = static_cast<int>(m & ((1u << kIndexBits) - 1));
+    }
   }
-  n.best_b.assign(best_b.begin(), best_b.begin() + nb);
+  for (int j = 0; j < nb; ++j)
+    n.best_b[static_cast<size_t>(j)] = static_cast<int>(key_b[static_cast<size_t>(j)] & ((1u << kIndexBits) - 1));
   return n;
 }
 

@@ -24,7 +24,7 @@ std::vector<uint64_t> descriptorWords(const cv::Mat& m);
 /// cross-checking BFMatcher runs two full searches: this is the matcher's
 /// innermost loop (n_target x n_source slice pairs), so the factor matters.
 /// Where the CPU has AVX-512 with VPOPCNTDQ (checked at run time, so one
-/// binary runs on any x86-64), eight distances are computed at once; the
+/// binary runs on any x86-64), sixty-four distances are computed at once; the
 /// answer is the same either way. `Scalar` forces the portable loop (tests).
 enum class HammingKernel { Fastest, Scalar };
 std::vector<std::pair<int, int>> mutualNearest(const cv::Mat& a, const cv::Mat& b,

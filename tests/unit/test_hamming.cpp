@@ -44,9 +44,11 @@ TEST(Hamming, TheVectorKernelGivesTheScalarKernelsMatchesTiesIncluded) {
   if (!vectorHammingAvailable()) GTEST_SKIP() << "this CPU has no AVX-512 VPOPCNTDQ: only the scalar kernel runs";
   cv::RNG rng(11);
   // Few distinct bytes make many equal distances, so the tie rules are exercised;
-  // sizes that are not multiples of 8 exercise the last, partial block.
-  for (const auto& [na, nb, values] : {std::tuple{1, 1, 256}, std::tuple{37, 13, 2}, std::tuple{64, 64, 3},
-                                       std::tuple{500, 999, 256}, std::tuple{9, 300, 4}}) {
+  // sizes that are not multiples of the kernel's 16 lanes or 4 rows exercise
+  // the last, partial block and the last rows.
+  for (const auto& [na, nb, values] :
+       {std::tuple{1, 1, 256}, std::tuple{37, 13, 2}, std::tuple{64, 64, 3}, std::tuple{500, 999, 256},
+        std::tuple{9, 300, 4}, std::tuple{3, 16, 2}, std::tuple{6, 17, 2}, std::tuple{1000, 1000, 256}}) {
     cv::Mat a(na, 32, CV_8U), b(nb, 32, CV_8U);
     rng.fill(a, cv::RNG::UNIFORM, 0, values);
     rng.fill(b, cv::RNG::UNIFORM, 0, values);
