@@ -1,6 +1,5 @@
 #include "features.hpp"
 
-#include <opencv2/features2d.hpp>
 #include <utility>
 
 namespace tomomap {
@@ -19,6 +18,10 @@ Eigen::Vector2d MapFeatures::centre() const {
   return n ? Eigen::Vector2d(sum / static_cast<double>(n)) : sum;
 }
 
+cv::Ptr<cv::ORB> sliceDetector(const FeatureParams& params) {
+  return cv::ORB::create(params.max_features, 1.2f, 1, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31, params.fast_threshold);
+}
+
 MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params) {
   MapFeatures out;
   out.grid = stack.grid.cell;
@@ -29,22 +32,22 @@ MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params) {
 #pragma omp parallel for schedule(dynamic)
   for (int k = 0; k < stack.size(); ++k) {
     if (stack.cells[static_cast<size_t>(k)].empty()) continue;
-    // One single-level detector per slice: the images are metric, so there is no
-    // scale to search over, and the detector is not thread-safe to share.
-    auto orb =
-        cv::ORB::create(params.max_features, 1.2f, 1, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31, params.fast_threshold);
-    const cv::Mat img = stack.image(k, params.pad);
+    // Only the occupied part of the raster, padded: the same keypoints and
+    // descriptors as on the whole image (every one sits on an occupied cell,
+    // and the pad holds its patch and blur), in half the time on a street
+    // whose slices are two facades crossing a wide raster.
+    const cv::Rect area = stack.occupiedArea(k);
+    const cv::Mat img = stack.image(k, area, params.pad);
     std::vector<cv::KeyPoint> kps;
     cv::Mat desc;
-    orb->detectAndCompute(img, cv::noArray(), kps, desc);
+    sliceDetector(params)->detectAndCompute(img, cv::noArray(), kps, desc);  // one each: not thread-safe to share
     if (kps.empty()) continue;
     SliceFeatures& sf = per_slice[static_cast<size_t>(k)];
     sf.index = k;
     sf.descriptors = desc;
     sf.keypoints.reserve(kps.size());
-    for (const auto& kp : kps)
-      sf.keypoints.push_back(
-          stack.grid.toMetres(kp.pt.x - static_cast<float>(params.pad), kp.pt.y - static_cast<float>(params.pad)));
+    const cv::Point2f origin(static_cast<float>(area.x - params.pad), static_cast<float>(area.y - params.pad));
+    for (const auto& kp : kps) sf.keypoints.push_back(stack.grid.toMetres(kp.pt.x + origin.x, kp.pt.y + origin.y));
   }
   out.occupancy = std::move(stack);
   for (auto& sf : per_slice)

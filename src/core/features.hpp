@@ -1,6 +1,7 @@
 #pragma once
 // ORB features per slice: the compact description of a map that crosses the network.
 #include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
 
 #include "gravity.hpp"
 #include "slices.hpp"
@@ -10,7 +11,8 @@ namespace tomomap {
 struct FeatureParams {
   int max_features = 1000;  ///< best-K ORB keypoints kept per slice
   int fast_threshold = 20;  ///< FAST corner threshold on the 0/255 images
-  int pad = 32;             ///< empty border added before detection [pixels]; >= ORB's edge threshold
+  int pad = 32;  ///< empty border around each slice image [pixels]: >= ORB's edge threshold (31) and its patch and blur
+                 ///< reach (about 25)
 };
 
 struct SliceFeatures {
@@ -37,6 +39,10 @@ struct MapFeatures {
   size_t featureCount() const;
   Eigen::Vector2d centre() const;  ///< mean x, y of the keypoints [m]
 };
+
+/// The ORB detector for one slice image: a single level, as the images are
+/// metric and there is no scale to search over. Not thread-safe to share.
+cv::Ptr<cv::ORB> sliceDetector(const FeatureParams& params);
 
 /// Detects ORB on every non-empty slice. Parallel over slices. The stack moves
 /// into the result's `occupancy` (pass a copy to keep your own).

@@ -7,11 +7,27 @@
 
 namespace tomomap {
 
-cv::Mat SliceStack::image(int k, int pad) const {
-  cv::Mat img = cv::Mat::zeros(grid.height + 2 * pad, grid.width + 2 * pad, CV_8U);
-  for (uint32_t idx : cells[static_cast<size_t>(k)])
-    img.at<uint8_t>(static_cast<int>(idx) / grid.width + pad, static_cast<int>(idx) % grid.width + pad) = 255;
+cv::Mat SliceStack::image(int k, const cv::Rect& area, int pad) const {
+  cv::Mat img = cv::Mat::zeros(area.height + 2 * pad, area.width + 2 * pad, CV_8U);
+  const auto w = static_cast<uint32_t>(grid.width);
+  for (uint32_t idx : cells[static_cast<size_t>(k)]) {
+    const int u = static_cast<int>(idx % w) - area.x, v = static_cast<int>(idx / w) - area.y;
+    if (u >= 0 && v >= 0 && u < area.width && v < area.height) img.at<uint8_t>(v + pad, u + pad) = 255;
+  }
   return img;
+}
+
+cv::Rect SliceStack::occupiedArea(int k) const {
+  const std::vector<uint32_t>& c = cells[static_cast<size_t>(k)];
+  if (c.empty()) return {};
+  const auto w = static_cast<uint32_t>(grid.width);
+  uint32_t u0 = w, u1 = 0;
+  for (uint32_t idx : c) {
+    u0 = std::min(u0, idx % w);
+    u1 = std::max(u1, idx % w);
+  }
+  const uint32_t v0 = c.front() / w, v1 = c.back() / w;  // cells are sorted by v, then u
+  return {static_cast<int>(u0), static_cast<int>(v0), static_cast<int>(u1 - u0 + 1), static_cast<int>(v1 - v0 + 1)};
 }
 
 SliceStack makeSlices(const Points& points, double cell) {

@@ -42,7 +42,12 @@ struct SliceStack {
   int size() const { return static_cast<int>(cells.size()); }
   /// Renders slice k as a CV_8U image, 255 = occupied, with `pad` empty pixels
   /// around it (ORB finds no corners within its border distance).
-  cv::Mat image(int k, int pad = 0) const;
+  cv::Mat image(int k, int pad = 0) const { return image(k, cv::Rect(0, 0, grid.width, grid.height), pad); }
+  /// The same for `area` of the raster alone: its pixel (0, 0) is raster pixel
+  /// (area.x - pad, area.y - pad).
+  cv::Mat image(int k, const cv::Rect& area, int pad) const;
+  /// The smallest area of the raster that holds slice k's occupied cells.
+  cv::Rect occupiedArea(int k) const;
 };
 
 /// Largest image side accepted, so a tiny grid on a large map fails loudly
