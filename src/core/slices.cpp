@@ -57,23 +57,65 @@ SliceStack makeSlices(const Points& points, double cell) {
   g.width = static_cast<int>(w);
   g.height = static_cast<int>(h);
 
-  auto& cells = stack.cells;
-  cells.resize(static_cast<size_t>(n));
-  for (const auto& p : points) {
-    if (bounds.outside > 0 && !bounds.contains(p)) continue;
+  // Each point's cell, grouped by slice (a counting sort), then each slice's
+  // cells marked in a bitmap of the raster and read back in order: sorted and
+  // unique in two linear passes, where sorting each slice's cells took most of
+  // the slicing time on a 2 M-point building.
+  const auto slices = static_cast<size_t>(n);
+  std::vector<uint32_t> slice_of(points.size()), cell_of(points.size());
+  std::vector<size_t> start(slices + 1, 0);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f& p = points[i];
+    if (bounds.outside > 0 && !bounds.contains(p)) {
+      slice_of[i] = static_cast<uint32_t>(slices);  // left out
+      continue;
+    }
     const int k = std::clamp(g.sliceIndex(p.z()), 0, static_cast<int>(n) - 1);
     const int u = std::min(static_cast<int>((p.x() - g.x_min) / cell), g.width - 1);
     const int v = std::min(static_cast<int>((p.y() - g.y_min) / cell), g.height - 1);
-    cells[static_cast<size_t>(k)].push_back(static_cast<uint32_t>(v * g.width + u));
+    slice_of[i] = static_cast<uint32_t>(k);
+    cell_of[i] = static_cast<uint32_t>(v * g.width + u);
+    ++start[static_cast<size_t>(k) + 1];
   }
+  for (size_t k = 1; k <= slices; ++k) start[k] += start[k - 1];
+  std::vector<uint32_t> grouped(start[slices]);
+  {
+    std::vector<size_t> next(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < points.size(); ++i)
+      if (slice_of[i] < slices) grouped[next[slice_of[i]]++] = cell_of[i];
+  }
+  std::vector<uint32_t>().swap(slice_of);
+  std::vector<uint32_t>().swap(cell_of);
+
   // Half of the customary minimum (width + height cells): a noise-free street's two
   // facades are thin lines about as long as the image, and the full threshold
   // dropped exactly the slices that describe it.
   const size_t min_cells = static_cast<size_t>(g.width + g.height) / 2;
-  for (auto& c : cells) {
-    std::sort(c.begin(), c.end());
-    c.erase(std::unique(c.begin(), c.end()), c.end());
-    if (c.size() < min_cells) std::vector<uint32_t>().swap(c);
+  const size_t raster_words = (static_cast<size_t>(g.width) * static_cast<size_t>(g.height) + 63) / 64;
+  auto& cells = stack.cells;
+  cells.resize(slices);
+#pragma omp parallel
+  {
+    std::vector<uint64_t> marked(raster_words);
+#pragma omp for schedule(dynamic)
+    for (long long k = 0; k < static_cast<long long>(slices); ++k) {
+      const auto first = grouped.begin() + static_cast<long>(start[static_cast<size_t>(k)]),
+                 last = grouped.begin() + static_cast<long>(start[static_cast<size_t>(k) + 1]);
+      if (static_cast<size_t>(last - first) < min_cells) continue;  // fewer points than cells needed
+      size_t lo_word = raster_words, hi_word = 0;
+      for (auto c = first; c != last; ++c) {
+        marked[*c / 64] |= uint64_t{1} << (*c % 64);
+        lo_word = std::min<size_t>(lo_word, *c / 64);
+        hi_word = std::max<size_t>(hi_word, *c / 64);
+      }
+      std::vector<uint32_t>& out = cells[static_cast<size_t>(k)];
+      for (size_t word = lo_word; word <= hi_word; ++word) {
+        for (uint64_t bits = marked[word]; bits != 0; bits &= bits - 1)
+          out.push_back(static_cast<uint32_t>(word * 64 + static_cast<size_t>(__builtin_ctzll(bits))));
+        marked[word] = 0;
+      }
+      if (out.size() < min_cells) std::vector<uint32_t>().swap(out);
+    }
   }
 
   auto first = std::find_if(cells.begin(), cells.end(), [](const auto& c) { return !c.empty(); });
