@@ -33,12 +33,6 @@ constexpr size_t kSamplesPerOffset = 8;
 /// support already makes the match ambiguous (matcher.cpp).
 constexpr double kRivalShare = 0.5;
 
-/// Below this many times min_support, a winner is judged ambiguous by an
-/// absolute margin (another answer within min_support pairs of it,
-/// matcher.cpp), finer than a sample of a few pairs per offset can resolve:
-/// such weak winners are checked against every pair.
-constexpr int kSampledSupport = 5;
-
 /// The slice pairs on each height offset's diagonal (target slice index -
 /// source slice index), as table indices by increasing target slice.
 class Diagonals {
@@ -87,7 +81,7 @@ std::vector<size_t> nextPairs(const SlicePairTable& table, const Diagonals& diag
   const std::vector<OffsetScore> scores = scoreOffsets(table, target, source, params);
   const OffsetChoice choice = pickOffset(scores, params, source.centre());
   const int best = choice.best ? static_cast<int>(choice.best->consensus.support()) : 0;
-  if (best < kSampledSupport * params.min_support) {
+  if (weakWinner(best, params)) {  // checked against every pair
     for (size_t k = 0; k < table.matched.size(); ++k)
       if (!table.matched[k]) todo.push_back(k);
     return todo;
