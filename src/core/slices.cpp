@@ -1,6 +1,7 @@
 #include "slices.hpp"
 
 #include <algorithm>
+#include <optional>
 
 #include "map_bounds.hpp"
 #include "text.hpp"
@@ -62,30 +63,27 @@ SliceStack makeSlices(const Points& points, double cell) {
   // unique in two linear passes, where sorting each slice's cells took most of
   // the slicing time on a 2 M-point building.
   const auto slices = static_cast<size_t>(n);
-  std::vector<uint32_t> slice_of(points.size()), cell_of(points.size());
-  std::vector<size_t> start(slices + 1, 0);
-  for (size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3f& p = points[i];
-    if (bounds.outside > 0 && !bounds.contains(p)) {
-      slice_of[i] = static_cast<uint32_t>(slices);  // left out
-      continue;
-    }
+  // A point's slice and cell, or nothing for a point left out as stray. Worked
+  // out again in each pass rather than kept in two arrays the size of the map,
+  // whose memory traffic made slicing twice as slow (0.11 against 0.055 s on a
+  // 2.3 M-voxel building).
+  const auto place = [&](const Eigen::Vector3f& p) -> std::optional<std::pair<size_t, uint32_t>> {
+    if (bounds.outside > 0 && !bounds.contains(p)) return std::nullopt;
     const int k = std::clamp(g.sliceIndex(p.z()), 0, static_cast<int>(n) - 1);
     const int u = std::min(static_cast<int>((p.x() - g.x_min) / cell), g.width - 1);
     const int v = std::min(static_cast<int>((p.y() - g.y_min) / cell), g.height - 1);
-    slice_of[i] = static_cast<uint32_t>(k);
-    cell_of[i] = static_cast<uint32_t>(v * g.width + u);
-    ++start[static_cast<size_t>(k) + 1];
-  }
+    return std::pair{static_cast<size_t>(k), static_cast<uint32_t>(v * g.width + u)};
+  };
+  std::vector<size_t> start(slices + 1, 0);
+  for (const auto& p : points)
+    if (const auto at = place(p)) ++start[at->first + 1];
   for (size_t k = 1; k <= slices; ++k) start[k] += start[k - 1];
   std::vector<uint32_t> grouped(start[slices]);
   {
     std::vector<size_t> next(start.begin(), start.end() - 1);
-    for (size_t i = 0; i < points.size(); ++i)
-      if (slice_of[i] < slices) grouped[next[slice_of[i]]++] = cell_of[i];
+    for (const auto& p : points)
+      if (const auto at = place(p)) grouped[next[at->first]++] = at->second;
   }
-  std::vector<uint32_t>().swap(slice_of);
-  std::vector<uint32_t>().swap(cell_of);
 
   // Half of the customary minimum (width + height cells): a noise-free street's two
   // facades are thin lines about as long as the image, and the full threshold
