@@ -106,3 +106,21 @@ TEST(SmallRooms, AWeakFeatureWinnerIsCheckedDenselyHoweverFarItLeads) {
       << "answered wrong: " << e.translation << " m, " << e.yaw << " rad off (support " << r.support << " vs "
       << r.runner_up_support << ")";
 }
+
+// A high-noise room at g 0.05 (seed 14) came out of the features reliable and
+// half-turned (9 slice pairs against 5) while the dense search preferred the
+// right pose by 1.35x, short of the 1.4x it needs to answer. Refusing needs
+// less than answering: that lead is enough to refuse the features.
+TEST(SmallRooms, ADenseSearchShortOfAnsweringStillRefusesAFeatureAnswerItContradicts) {
+  SceneParams sp;
+  sp.type = WorldType::Room;
+  sp.seed = 14;
+  const auto maps = scanScene(makeScene(sp), noiseLevel("high"), sp.seed);
+  MatchParams mp;
+  mp.grid = 0.05;
+  const MatchResult r = matchMaps(maps[0].points, maps[1].points, mp);
+  const PoseError e = poseError(r.T_target_source, Pose4::fromMatrix(maps[0].pose * maps[1].pose.inverse()));
+  EXPECT_TRUE(!r.reliable || (e.translation < 5 * mp.grid && e.yaw < radians(10)))
+      << "answered wrong: " << e.translation << " m, " << e.yaw << " rad off (support " << r.support << " vs "
+      << r.runner_up_support << ", dense lead " << r.dense_lead << ")";
+}
