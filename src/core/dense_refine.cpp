@@ -72,9 +72,14 @@ DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& 
     const int r = static_cast<int>(std::ceil(radius_cells));
     const double max_d2 = radius_cells * radius_cells;
     for (int it = 0; it < params.iterations_per_stage; ++it) {
-      Correspondences c;
       const Rigid2D& T = result.transform;
-      for (const auto& p : pairs) {
+      // Each slice pair's correspondences on its own, in parallel, then joined
+      // in pair order: the same fit as one serial pass.
+      std::vector<Correspondences> per_pair(pairs.size());
+#pragma omp parallel for schedule(dynamic)
+      for (size_t n = 0; n < pairs.size(); ++n) {
+        const PairCells& p = pairs[n];
+        Correspondences& c = per_pair[n];
         for (const auto& s : p.source) {
           const Eigen::Vector2d q = T.apply(s);
           // Target pixel coordinates (centres are integers).
@@ -98,6 +103,11 @@ DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& 
           c.source.push_back(s);
           c.target.push_back(tg.toMetres(static_cast<float>(bu), static_cast<float>(bv)).cast<double>());
         }
+      }
+      Correspondences c;
+      for (const Correspondences& p : per_pair) {
+        c.source.insert(c.source.end(), p.source.begin(), p.source.end());
+        c.target.insert(c.target.end(), p.target.begin(), p.target.end());
       }
       if (c.size() < 3) return result;
       const Rigid2D next = fitRigid2D(c);
