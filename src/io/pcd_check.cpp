@@ -44,8 +44,11 @@ class MappedFile {
     ::close(fd);
     if (size_ > 0 && !data_) throw InputError(path + ": cannot read");
   }
-  ~MappedFile() {
+  ~MappedFile() { release(); }
+  /// Unmaps the file early: its pages count in the process's memory.
+  void release() {
     if (data_) ::munmap(const_cast<char*>(data_), size_);
+    data_ = nullptr;
   }
   MappedFile(const MappedFile&) = delete;
   MappedFile& operator=(const MappedFile&) = delete;
@@ -144,7 +147,7 @@ float readFloat(const char* p, bool as_double) {
 }  // namespace
 
 std::optional<Points> checkAndReadPcd(const std::string& path) {
-  const MappedFile file(path);
+  MappedFile file(path);
   auto fail = [&](const std::string& why) { throw InputError(path + ": " + why); };
   PcdHeader h = parseHeader(file);
   if (h.data.empty()) fail("not a PCD file (no DATA line in the header)");
@@ -193,6 +196,7 @@ std::optional<Points> checkAndReadPcd(const std::string& path) {
   const HugeBuffer raw(unpacked);
   if (pcl::lzfDecompress(data + 8, packed, raw.get(), unpacked) != unpacked)
     fail("corrupt: compressed data does not decompress");
+  file.release();  // before the points are allocated: a map's compressed file no longer beside them
   if (!xyz) return std::nullopt;
   // Compressed PCD data is stored field by field: all x, then all y, ...
   Points out(n);
