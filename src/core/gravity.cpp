@@ -33,7 +33,10 @@ struct Patch {
   double weight;
 };
 
-std::vector<Patch> flatPatches(const Points& map, double side) {
+/// Every `stride`-th point of `map`, turned by `turn`, binned in cubes of `side`.
+/// The points are read where they lie, not copied: a sample of a large map,
+/// and its turned copy, would sit beside the voxel filter's buffers.
+std::vector<Patch> flatPatches(const Points& map, size_t stride, const Eigen::Matrix3f& turn, double side) {
   struct Sums {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
@@ -46,7 +49,9 @@ std::vector<Patch> flatPatches(const Points& map, double side) {
     return (cell(p.z()) << 42) | (cell(p.y()) << 21) | cell(p.x());
   };
   std::unordered_map<uint64_t, Sums> cubes;
-  for (const auto& p : map) {
+  const bool turned = !turn.isIdentity(0.0f);
+  for (size_t i = 0; i < map.size(); i += stride) {
+    const Eigen::Vector3f p = turned ? Eigen::Vector3f(turn * map[i]) : map[i];
     Sums& s = cubes[key(p)];
     const Eigen::Vector3d q = p.cast<double>();
     s.sum += q;
@@ -100,9 +105,6 @@ std::optional<Eigen::Vector3d> upOf(const std::vector<Patch>& patches, size_t& f
 Tilt estimateTilt(const Points& map, double grid) {
   // Every k-th point: a few hundred thousand describe the large surfaces.
   const size_t stride = std::max<size_t>(1, map.size() / kMaxPoints);
-  Points sample;
-  sample.reserve(map.size() / stride + 1);
-  for (size_t i = 0; i < map.size(); i += stride) sample.push_back(map[i]);
 
   // The cubes are axis-aligned: a leaning floor cut at a cube's top and bottom
   // fits a little flatter than it is (a 10 deg lean read as 9.3). Measured
@@ -111,8 +113,8 @@ Tilt estimateTilt(const Points& map, double grid) {
   Eigen::Quaterniond leveling = Eigen::Quaterniond::Identity();
   const double side = std::max(kMinPatchSide, kPatchCells * grid);
   for (int pass = 0; pass < kPasses; ++pass) {
-    const auto up =
-        upOf(flatPatches(pass == 0 ? sample : rotatePoints(sample, leveling), side), t.floor_patches, t.wall_patches);
+    const Eigen::Matrix3f turn = leveling.toRotationMatrix().cast<float>();  // as rotatePoints turns
+    const auto up = upOf(flatPatches(map, stride, turn, side), t.floor_patches, t.wall_patches);
     if (!up) return t;
     leveling = Eigen::Quaterniond::FromTwoVectors(*up, Eigen::Vector3d::UnitZ()) * leveling;
   }
