@@ -21,7 +21,7 @@ bench() {
   local cmd=(${MATCH:-$tomomap match})
   local times=() rss=()
   for ((i = 0; i < runs; i++)); do
-    /usr/bin/time -f "%e %M" -o "$work/t" "${cmd[@]}" "$target" "$source" --grid "$grid" "$@" >"$work/out" || true
+    /usr/bin/time -f "%e %M" -o "$work/t" "${cmd[@]}" "$target" "$source" --grid "$grid" "$@" >"$work/out" 2>"$work/err" || true
     read -r t m <"$work/t"
     times+=("$t"); rss+=("$m")
   done
