@@ -3,6 +3,8 @@
 // the full-size ones under the `large` label.
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include "core/matcher.hpp"
 #include "synth/synth.hpp"
 
@@ -60,6 +62,35 @@ INSTANTIATE_TEST_SUITE_P(LargeWorlds, SynthAccuracy,
                                            WorldCase{WorldType::Outdoor, "low"}, WorldCase{WorldType::Outdoor, "high"}),
                          caseName);
 
+/// One room pair of `synth -w room` matched at `grid`, and how far it is off.
+struct RoomMatch {
+  MatchResult result;
+  PoseError error;
+  /// The paper's rule, as for the tall worlds above.
+  bool right(double grid) const { return error.translation < 5 * grid && error.yaw < radians(10); }
+  bool answeredWrong(double grid) const { return result.reliable && !right(grid); }
+};
+
+RoomMatch matchRoom(uint64_t seed, const char* noise, double grid) {
+  SceneParams sp;
+  sp.type = WorldType::Room;
+  sp.seed = seed;
+  const auto maps = scanScene(makeScene(sp), noiseLevel(noise), seed);
+  MatchParams mp;
+  mp.grid = grid;
+  RoomMatch m;
+  m.result = matchMaps(maps[0].points, maps[1].points, mp);
+  m.error = poseError(m.result.T_target_source, Pose4::fromMatrix(maps[0].pose * maps[1].pose.inverse()));
+  return m;
+}
+
+std::string wrongAnswer(const RoomMatch& m) {
+  std::ostringstream out;
+  out << "answered wrong: " << m.error.translation << " m, " << m.error.yaw << " rad off (support " << m.result.support
+      << " vs " << m.result.runner_up_support << ", dense lead " << m.result.dense_lead << ")";
+  return out.str();
+}
+
 // Small rooms (under 32 slices at g 0.1, partial overlap): the features alone
 // refused all ten (docs/results.md, "Small rooms"); the dense search answers
 // them. At g 0.1 they must succeed as often as the tall worlds above; at
@@ -69,15 +100,9 @@ TEST(SmallRooms, SucceedLikeTallMapsAtTheirGridAndAreNeverAnsweredWrong) {
   for (const auto& [grid, needed] : {std::pair{0.1, 9}, std::pair{0.05, 5}}) {
     int right = 0, refused = 0, wrong = 0;
     for (uint64_t seed = 1; seed <= 10; ++seed) {
-      SceneParams sp;
-      sp.type = WorldType::Room;
-      sp.seed = seed;
-      const auto maps = scanScene(makeScene(sp), noiseLevel("low"), seed);
-      MatchParams mp;
-      mp.grid = grid;
-      const MatchResult r = matchMaps(maps[0].points, maps[1].points, mp);
-      const PoseError e = poseError(r.T_target_source, Pose4::fromMatrix(maps[0].pose * maps[1].pose.inverse()));
-      const bool ok = e.translation < 5 * grid && e.yaw < radians(10);
+      const RoomMatch m = matchRoom(seed, "low", grid);
+      const MatchResult& r = m.result;
+      const bool ok = m.right(grid);
       (r.reliable ? (ok ? right : wrong) : refused)++;
       std::cout << "room seed " << seed << " g " << grid << ": "
                 << (r.reliable ? (ok ? "right" : "WRONG") + (" by " + r.method) : "no reliable match: " + r.reason)
@@ -93,18 +118,9 @@ TEST(SmallRooms, SucceedLikeTallMapsAtTheirGridAndAreNeverAnsweredWrong) {
 // half-turned: 7 slice pairs against 3, a lead of more than 2x, which then
 // skipped the dense check. A weak winner is checked however far it leads.
 TEST(SmallRooms, AWeakFeatureWinnerIsCheckedDenselyHoweverFarItLeads) {
-  SceneParams sp;
-  sp.type = WorldType::Room;
-  sp.seed = 8;
-  const auto maps = scanScene(makeScene(sp), noiseLevel("none"), sp.seed);
-  MatchParams mp;
-  mp.grid = 0.05;
-  const MatchResult r = matchMaps(maps[0].points, maps[1].points, mp);
-  EXPECT_GT(r.dense_lead, 0.0) << "the dense search did not run";
-  const PoseError e = poseError(r.T_target_source, Pose4::fromMatrix(maps[0].pose * maps[1].pose.inverse()));
-  EXPECT_TRUE(!r.reliable || (e.translation < 5 * mp.grid && e.yaw < radians(10)))
-      << "answered wrong: " << e.translation << " m, " << e.yaw << " rad off (support " << r.support << " vs "
-      << r.runner_up_support << ")";
+  const RoomMatch m = matchRoom(8, "none", 0.05);
+  EXPECT_GT(m.result.dense_lead, 0.0) << "the dense search did not run";
+  EXPECT_FALSE(m.answeredWrong(0.05)) << wrongAnswer(m);
 }
 
 // A high-noise room at g 0.05 (seed 14) came out of the features reliable and
@@ -112,15 +128,6 @@ TEST(SmallRooms, AWeakFeatureWinnerIsCheckedDenselyHoweverFarItLeads) {
 // right pose by 1.35x, short of the 1.4x it needs to answer. Refusing needs
 // less than answering: that lead is enough to refuse the features.
 TEST(SmallRooms, ADenseSearchShortOfAnsweringStillRefusesAFeatureAnswerItContradicts) {
-  SceneParams sp;
-  sp.type = WorldType::Room;
-  sp.seed = 14;
-  const auto maps = scanScene(makeScene(sp), noiseLevel("high"), sp.seed);
-  MatchParams mp;
-  mp.grid = 0.05;
-  const MatchResult r = matchMaps(maps[0].points, maps[1].points, mp);
-  const PoseError e = poseError(r.T_target_source, Pose4::fromMatrix(maps[0].pose * maps[1].pose.inverse()));
-  EXPECT_TRUE(!r.reliable || (e.translation < 5 * mp.grid && e.yaw < radians(10)))
-      << "answered wrong: " << e.translation << " m, " << e.yaw << " rad off (support " << r.support << " vs "
-      << r.runner_up_support << ", dense lead " << r.dense_lead << ")";
+  const RoomMatch m = matchRoom(14, "high", 0.05);
+  EXPECT_FALSE(m.answeredWrong(0.05)) << wrongAnswer(m);
 }
