@@ -104,12 +104,12 @@ void consultDenseSearch(MatchResult& r, const MapFeatures& target, const MapFeat
   const DensePose& best = d.poses.front();
   const size_t next = d.poses.size() > 1 ? d.poses[1].telling_inliers : 0;
   r.dense_lead = static_cast<double>(best.telling_inliers) / static_cast<double>(std::max<size_t>(next, 1));
-  const bool clear = r.dense_lead >= kDenseLead && best.support >= params.min_support;
+  const auto leadsBy = [&](double lead) { return r.dense_lead >= lead && best.support >= params.min_support; };
+  const bool clear = leadsBy(kDenseLead);
   if (r.reliable) {
     const Rigid2D features{r.T_target_source.yaw, {r.T_target_source.x, r.T_target_source.y}};
-    if (r.dense_lead >= kDenseVeto && best.support >= params.min_support &&
-        (std::abs(best.offset - r.height_offset) > kSmearSlices / 2 ||
-         !agree(features, best.transform, same, source.centre()))) {
+    if (leadsBy(kDenseVeto) && (std::abs(best.offset - r.height_offset) > kSmearSlices / 2 ||
+                                !agree(features, best.transform, same, source.centre()))) {
       r.reliable = false;
       r.reason = "the features and a dense search of the occupancy disagree (" + fixed(r.dense_lead, 2) +
                  "x lead for a pose " + fixed((best.transform.t - features.t).norm(), 2) + " m, " +
