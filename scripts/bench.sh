@@ -46,29 +46,31 @@ if [ -f "$demo/demo-pcd1.pcd" ]; then
 else
   echo "demo-room not found at $demo: skipped"
 fi
+# benchWorld WORLD SCALE NAME TITLE GRIDS...: synthesises the world into
+# $work/WORLD-SCALE (the last one made is $world, for the benchmarks below) and
+# benches it at each grid.
+benchWorld() {
+  local kind=$1 scale=$2 name=$3 title=$4; shift 4
+  world=$work/$kind-$scale
+  "$tomomap" synth --world "$kind" --seed 1 --scale "$scale" --out "$world" >/dev/null
+  local pts
+  pts=$(grep -o '"points": [0-9]*' "$world/scene.json" | head -1 | awk '{print $2}')
+  echo "synthetic $title (--scale $scale), $pts points per map:"
+  for g in "$@"; do
+    bench "  $name (g $g)" "$world/map_0.pcd" "$world/map_1.pcd" "$g" \
+      --gt-target "$world/map_0-gtpose.txt" --gt-source "$world/map_1-gtpose.txt"
+  done
+}
 # The worlds of issue 15's table (the building of 1.85 M points a map and the
 # street of 583 k points, at --scale 1), then larger ones (--scale 2.5 and 2).
-for scale in 1 2.5; do
-  b=$work/building-$scale
-  "$tomomap" synth --world indoor --seed 1 --scale "$scale" --out "$b" >/dev/null
-  pts=$(grep -o '"points": [0-9]*' "$b/scene.json" | head -1 | awk '{print $2}')
-  echo "synthetic 2-floor building (--scale $scale, 14 x 6.2 m across), $pts points per map:"
-  for g in 0.2 0.1 0.05; do
-    bench "  building (g $g)" "$b/map_0.pcd" "$b/map_1.pcd" "$g" --gt-target "$b/map_0-gtpose.txt" --gt-source "$b/map_1-gtpose.txt"
-  done
-done
+benchWorld indoor 1 building "2-floor building, 14 x 6.2 m across" 0.2 0.1 0.05
+benchWorld indoor 2.5 building "2-floor building, 14 x 6.2 m across" 0.2 0.1 0.05
+b=$world
 # The indexed search's baseline, in the same run: every slice pair matched.
 bench "  building (g 0.05), --exhaustive" "$b/map_0.pcd" "$b/map_1.pcd" 0.05 --exhaustive \
   --gt-target "$b/map_0-gtpose.txt" --gt-source "$b/map_1-gtpose.txt"
-for scale in 1 2; do
-  s=$work/street-$scale
-  "$tomomap" synth --world outdoor --seed 1 --scale "$scale" --out "$s" >/dev/null
-  pts=$(grep -o '"points": [0-9]*' "$s/scene.json" | head -1 | awk '{print $2}')
-  echo "synthetic street (--scale $scale), $pts points per map:"
-  for g in 0.5 0.2 0.1; do
-    bench "  street (g $g)" "$s/map_0.pcd" "$s/map_1.pcd" "$g" --gt-target "$s/map_0-gtpose.txt" --gt-source "$s/map_1-gtpose.txt"
-  done
-done
+benchWorld outdoor 1 street street 0.5 0.2 0.1
+benchWorld outdoor 2 street street 0.5 0.2 0.1
 # Incremental re-matching (the daemon after a map update): one source slice
 # range changes; the pair is matched from scratch and with the rest recalled.
 rematch=${BUILD_DIR:-build}/tests/bench_rematch
