@@ -9,7 +9,7 @@ PACKAGES=(
   libpcl-dev libopenmpi-dev libeigen3-dev libopencv-dev liboctomap-dev libceres-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
-  libssl-dev
+  libssl-dev liblzf-dev
   libgtest-dev libgmock-dev libbenchmark-dev libsystemd-dev zlib1g-dev libpng-dev
   python3 time
   file dpkg-dev systemd  # CPack's .deb dependency scan; systemd-analyze checks the unit in the tests

@@ -1,14 +1,7 @@
 #include "map_io.hpp"
 
-#include <pcl/common/io.h>
-#include <pcl/console/print.h>
-#include <pcl/io/pcd_io.h>
-#include <pcl/io/ply_io.h>
-#include <pcl/point_types.h>
-
 #include <algorithm>
 #include <cctype>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -18,6 +11,7 @@
 #include "core/map_check.hpp"
 #include "octomap_io.hpp"
 #include "pcd_check.hpp"
+#include "pcl_module.hpp"
 
 namespace tomomap {
 namespace {
@@ -29,52 +23,13 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
-// PCL reports parse problems on stderr; we report them ourselves, once.
-void silencePcl() { pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); }
-
-/// Reads x, y, z straight out of PCL's blob: no intermediate PointCloud, which
-/// for a map of millions of points would hold a third copy in memory.
-Points fromBlob(const pcl::PCLPointCloud2& blob, const std::string& path) {
-  int offset[3];
-  uint8_t type[3];
-  const char* axes[3] = {"x", "y", "z"};
-  for (int a = 0; a < 3; ++a) {
-    const int f = pcl::getFieldIndex(blob, axes[a]);
-    if (f < 0) throw InputError(path + ": has no '" + axes[a] + "' field");
-    offset[a] = static_cast<int>(blob.fields[static_cast<size_t>(f)].offset);
-    type[a] = blob.fields[static_cast<size_t>(f)].datatype;
-    if (type[a] != pcl::PCLPointField::FLOAT32 && type[a] != pcl::PCLPointField::FLOAT64)
-      throw InputError(path + ": field '" + axes[a] + "' is not a float");
-  }
-  const size_t n = static_cast<size_t>(blob.width) * blob.height;
-  if (blob.point_step == 0 || blob.data.size() < n * blob.point_step)
-    throw InputError(path + ": truncated (header declares " + std::to_string(n) + " points)");
-  Points out(n);
-  for (size_t i = 0; i < n; ++i) {
-    const uint8_t* p = blob.data.data() + i * blob.point_step;
-    for (int a = 0; a < 3; ++a) {
-      if (type[a] == pcl::PCLPointField::FLOAT32) {
-        float v;
-        std::memcpy(&v, p + offset[a], sizeof v);
-        out[i][a] = v;
-      } else {
-        double v;
-        std::memcpy(&v, p + offset[a], sizeof v);
-        out[i][a] = static_cast<float>(v);
-      }
-    }
-  }
-  return out;
-}
-
-Points loadPcl(const std::string& path, bool ply) {
-  silencePcl();
+Points loadPcdOrPly(const std::string& path, bool ply) {
   if (!ply)
     if (std::optional<Points> read = checkAndReadPcd(path)) return std::move(*read);
-  pcl::PCLPointCloud2 blob;
-  const int rc = ply ? pcl::io::loadPLYFile(path, blob) : pcl::io::loadPCDFile(path, blob);
-  if (rc < 0) throw InputError(path + ": not a readable " + (ply ? "PLY" : "PCD") + " file (corrupt or truncated)");
-  return fromBlob(blob, path);
+  Points points;
+  std::string error;
+  if (!pclIo().load(path, ply, &points, &error)) throw InputError(error);
+  return points;
 }
 
 /// x, y, z from the first three whitespace-separated fields of `line`, if
@@ -144,9 +99,9 @@ Points loadMap(const std::string& path, size_t* nonfinite, std::string* note) {
   const std::string ext = lowerExtension(path);
   Points points;
   if (ext == ".pcd")
-    points = loadPcl(path, false);
+    points = loadPcdOrPly(path, false);
   else if (ext == ".ply") {
-    points = loadPcl(path, true);
+    points = loadPcdOrPly(path, true);
     if (const size_t faces = plyFaces(path); faces > 0 && note)
       *note = path + ": a mesh: its " + std::to_string(points.size()) + " vertices are the map, its " +
               std::to_string(faces) + " faces are not used";
@@ -169,12 +124,8 @@ Points loadMap(const std::string& path, size_t* nonfinite, std::string* note) {
 }
 
 void savePcd(const std::string& path, const Points& points) {
-  silencePcl();
-  pcl::PointCloud<pcl::PointXYZ> cloud;
-  cloud.reserve(points.size());
-  for (const auto& p : points) cloud.push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-  if (cloud.empty() || pcl::io::savePCDFileBinaryCompressed(path, cloud) < 0)
-    throw InputError(path + ": cannot write map");
+  std::string error;
+  if (!pclIo().savePcd(path, points, &error)) throw InputError(error);
 }
 
 Eigen::Matrix4d loadPoseFile(const std::string& path) {

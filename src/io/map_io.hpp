@@ -1,5 +1,5 @@
 #pragma once
-// Reading and writing map and pose files: the only place that links PCL's io.
+// Reading and writing map and pose files (PCL's io only through pcl_module.hpp).
 #include <string>
 
 #include "core/map_check.hpp"

@@ -1,7 +1,7 @@
 #include "pcd_check.hpp"
 
 #include <fcntl.h>
-#include <pcl/io/lzf.h>
+#include <lzf.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -194,7 +194,7 @@ std::optional<Points> checkAndReadPcd(const std::string& path) {
          std::to_string(expected));
   if (packed == 0 && unpacked == 0) return xyz ? std::optional<Points>(Points{}) : std::nullopt;
   const HugeBuffer raw(unpacked);
-  if (pcl::lzfDecompress(data + 8, packed, raw.get(), unpacked) != unpacked)
+  if (lzf_decompress(data + 8, packed, raw.get(), unpacked) != unpacked)
     fail("corrupt: compressed data does not decompress");
   file.release();  // before the points are allocated: a map's compressed file no longer beside them
   if (!xyz) return std::nullopt;

@@ -17,7 +17,8 @@ namespace tomomap {
 /// most SLAM tools write) it returns the points too: reading them through
 /// PCL's generic blob afterwards decompressed the file a second time and
 /// held two more copies (docs/results.md, "Loading"). Otherwise (ascii,
-/// other field types) nullopt: PCL reads it.
+/// other field types) nullopt: PCL reads it, through pcl_module.hpp, so the
+/// common files never load PCL's io at all.
 std::optional<Points> checkAndReadPcd(const std::string& path);
 
 }  // namespace tomomap

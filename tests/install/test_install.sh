@@ -31,7 +31,7 @@ echo "== cpack -G DEB"
 deb=$(ls "$STAGE"/pkg/tomomap_*_amd64.deb)
 depends=$(dpkg-deb -f "$deb" Depends)
 echo "Depends: $depends"
-for p in libfastrtps2.9 libfastcdr1 libopencv-core406 libpcl-common1.13 libsystemd0 libtomlplusplus3; do
+for p in libfastrtps2.9 libfastcdr1 libopencv-core406 libpcl-common1.13 libpcl-io1.13 liblzf1 libsystemd0 libtomlplusplus3; do
   echo "$depends" | grep -q "$p" || fail "the .deb does not depend on $p"
 done
 echo "$depends" | grep -q -- "-dev" && fail "the .deb depends on a -dev package"
@@ -42,7 +42,7 @@ echo "== the .deb unpacked into $STAGE/root"
 dpkg-deb -x "$deb" "$STAGE/root"
 r="$STAGE/root"
 for f in usr/bin/tomomap usr/bin/tomomapd usr/bin/tomomap-baseline usr/lib/systemd/system/tomomapd.service \
-         etc/tomomap/tomomapd.toml usr/share/doc/tomomap/operations.md; do
+         usr/lib/tomomap/tomomap_pcl_io.so etc/tomomap/tomomapd.toml usr/share/doc/tomomap/operations.md; do
   check_file "$r/$f"
 done
 grep -q "^ExecStart=/usr/bin/tomomapd --config %E/tomomap/tomomapd.toml" "$r/usr/lib/systemd/system/tomomapd.service" ||
@@ -55,6 +55,20 @@ grep -q "^ExecStart=/usr/bin/tomomapd --config %E/tomomap/tomomapd.toml" "$r/usr
   --gt-target "$STAGE/world/map_0-gtpose.txt" --gt-source "$STAGE/world/map_1-gtpose.txt" > "$STAGE/match.txt" ||
   { cat "$STAGE/match.txt"; fail "installed tomomap match"; }
 grep -q "T_target_source" "$STAGE/match.txt" || fail "no transform printed"
+# Binary PCDs are read without PCL's io (and the 60 libraries it maps); synth's
+# writing above and a PLY load through the module, found next to the binary.
+LD_DEBUG=libs "$r/usr/bin/tomomap" match "$STAGE/world/map_0.pcd" "$STAGE/world/map_1.pcd" --grid 0.1 2>&1 >/dev/null |
+  grep -q "libpcl_io" && fail "matching binary PCDs loaded PCL's io"
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n' \
+  > "$STAGE/three.ply"
+out=$("$r/usr/bin/tomomap" match "$STAGE/three.ply" "$STAGE/three.ply" 2>&1) && fail "a 3-point map was matched"
+echo "$out" | grep -q "has only 3 points" || fail "the installed tomomap did not read a PLY: $out"
+# A binary copied away from its module says what is missing, and exits 2.
+mkdir -p "$STAGE/lonely" && cp "$r/usr/bin/tomomap" "$STAGE/lonely/"
+rc=0
+out=$("$STAGE/lonely/tomomap" match "$STAGE/three.ply" "$STAGE/three.ply" 2>&1) || rc=$?
+[ "$rc" -eq 2 ] || fail "without the module: exit $rc, expected 2 (bad input)"
+echo "$out" | grep -q "need the module tomomap_pcl_io.so" || fail "no clear error without the module: $out"
 "$r/usr/bin/tomomapd" --config "$r/etc/tomomap/tomomapd.toml" --check | grep -q "agent = robot1" ||
   fail "the packaged example config does not pass --check"
 
