@@ -30,10 +30,10 @@ struct MatchParams {
 
 /// Whether a winning answer with `support` agreeing slice pairs is weak: below
 /// five times min_support, its lead over another answer is judged by an
-/// absolute margin (another answer within min_support pairs, matcher.cpp),
-/// finer than a sample of a few pairs per offset resolves, so the indexed
-/// search matches every pair for it (offset_search.cpp); and on small maps the
-/// dense search checks it however far it leads (a noise-free room at g 0.05
+/// absolute margin (another answer within min_support pairs, matcher.cpp)
+/// rather than by a share of its support; the indexed search follows rivals
+/// by that margin (offset_search.cpp), and on small maps the dense search
+/// checks a weak winner however far it leads (a noise-free room at g 0.05
 /// came out reliable and half-turned at 7 slice pairs against 3).
 inline bool weakWinner(int support, const MatchParams& params) { return support < 5 * params.min_support; }
 

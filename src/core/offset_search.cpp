@@ -33,6 +33,11 @@ constexpr size_t kSamplesPerOffset = 8;
 /// support already makes the match ambiguous (matcher.cpp).
 constexpr double kRivalShare = 0.5;
 
+/// A winner under this many times min_support is checked against every pair:
+/// a rival to it (below) needs at most min_support agreeing pairs, too few for
+/// a sample of eight to tell from none.
+constexpr int kEveryPairBelow = 2;
+
 /// The slice pairs on each height offset's diagonal (target slice index -
 /// source slice index), as table indices by increasing target slice.
 class Diagonals {
@@ -81,11 +86,15 @@ std::vector<size_t> nextPairs(const SlicePairTable& table, const Diagonals& diag
   const std::vector<OffsetScore> scores = scoreOffsets(table, target, source, params);
   const OffsetChoice choice = pickOffset(scores, params, source.centre());
   const int best = choice.best ? static_cast<int>(choice.best->consensus.support()) : 0;
-  if (weakWinner(best, params)) {  // checked against every pair
+  if (!choice.best || best < kEveryPairBelow * params.min_support) {
     for (size_t k = 0; k < table.matched.size(); ++k)
       if (!table.matched[k]) todo.push_back(k);
     return todo;
   }
+  // The support a rival is judged against: the winner's, or for a weak winner
+  // the least that brings another answer within min_support pairs of it
+  // (ambiguous, matcher.cpp), an absolute margin the winner's share misses.
+  const int judged = weakWinner(best, params) ? best - params.min_support + 1 : best;
   addAround(choice.best->offset, diagonals, todo);
   if (choice.runner_up_support > 0) addAround(choice.runner_up_offset, diagonals, todo);
   for (const OffsetScore& s : scores) {
@@ -93,7 +102,8 @@ std::vector<size_t> nextPairs(const SlicePairTable& table, const Diagonals& diag
     const auto matched =
         static_cast<size_t>(std::count_if(pairs.begin(), pairs.end(), [&](size_t k) { return table.matched[k] != 0; }));
     const double projected = static_cast<double>(s.consensus.support() * pairs.size()) / static_cast<double>(matched);
-    if (matched < pairs.size() && projected >= kRivalShare * best) todo.insert(todo.end(), pairs.begin(), pairs.end());
+    if (matched < pairs.size() && projected >= kRivalShare * judged)
+      todo.insert(todo.end(), pairs.begin(), pairs.end());
   }
   todo.erase(std::remove_if(todo.begin(), todo.end(), [&](size_t k) { return table.matched[k] != 0; }), todo.end());
   return todo;
