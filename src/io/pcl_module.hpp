@@ -22,7 +22,7 @@ struct PclIo {
 
 /// Bumped whenever PclIo changes, so that a binary never calls a stale module.
 constexpr unsigned kPclIoVersion = 1;
-/// The module's file, found through the binaries' RUNPATH (CMakeLists.txt).
+/// The module's file, looked up in the folders the program's RUNPATH names (CMakeLists.txt).
 constexpr const char* kPclIoModule = "tomomap_pcl_io.so";
 /// Its entry point: the functions, or nullptr if `version` is not its own.
 constexpr const char* kPclIoEntry = "tomomap_pcl_io";
