@@ -223,7 +223,7 @@ void Agent::onPeer(const std::string& id, bool alive) {
   if (alive) {
     if (peers_.setAlive(id, true)) log_.info("peer " + id + " is up");
     board_.agentUp(id);
-    requestMissing(/*at_once=*/true);  // a request sent before it could hear us was lost
+    if (auto r = peers_.askNow(id, Clock::now())) bus_->publish(*r);  // what we asked it before was lost
     // Durability is meant to give it our announcement, but Fast DDS misses a
     // late reader now and then (eProsima/Fast-DDS#3822): announce again soon,
     // unless it asks for our slices first. A peer that comes up again may have
@@ -240,8 +240,8 @@ void Agent::onPeer(const std::string& id, bool alive) {
   }
 }
 
-void Agent::requestMissing(bool at_once) {
-  for (const auto& r : peers_.due(fromSeconds(config_.request_interval_s), at_once, Clock::now())) bus_->publish(r);
+void Agent::requestMissing() {
+  for (const auto& r : peers_.due(fromSeconds(config_.request_interval_s), Clock::now())) bus_->publish(r);
 }
 
 void Agent::claimAndCompute() {

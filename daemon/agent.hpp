@@ -99,7 +99,7 @@ class Agent {
   void onRefused(const std::string& participant, const std::string& why);
 
   // ---- what this agent does
-  void requestMissing(bool at_once = false);
+  void requestMissing();
   void claimAndCompute();
   void finishCompute();
   /// Whether a peer's announced grid is ours; says once per peer and grid when not.

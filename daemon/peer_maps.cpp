@@ -30,7 +30,11 @@ wire::ChunkRequest PeerMaps::requestFor(const std::string& owner, const Peer& p,
   r.stalled_ms(static_cast<uint32_t>(std::clamp<int64_t>(quiet, 0, UINT32_MAX)));
   const auto through = received_through_.find(owner);
   r.received_through(through == received_through_.end() ? 0 : through->second);
-  if (!everything) r.slices(p.incoming->missing());  // else an empty list: everything
+  if (everything) return r;  // an empty list asks for every announced slice
+  // Listed only once some slice is in: until then the empty list says the
+  // same in 4 bytes a slice less (and the request reaches every receiver).
+  auto missing = p.incoming->missing();
+  if (missing.size() < p.incoming->sliceCount()) r.slices(std::move(missing));
   return r;
 }
 
@@ -132,18 +136,32 @@ void PeerMaps::complete(const std::string& owner, Peer& p) {
             fixed(rateKbps(p), 0) + " kbit/s while sending)");
 }
 
-std::vector<wire::ChunkRequest> PeerMaps::due(Clock::duration interval, bool at_once, Clock::time_point now) {
+bool PeerMaps::waiting(const Peer& p) { return p.incoming && !p.features && !p.incoming->refused(); }
+
+wire::ChunkRequest PeerMaps::askAgain(const std::string& owner, Peer& p, Clock::time_point now) {
+  wire::ChunkRequest r = requestFor(owner, p, /*everything=*/false, now);
+  p.last_request = now;
+  ++p.unanswered;
+  const size_t wanted = r.slices().empty() ? p.incoming->sliceCount() : r.slices().size();
+  log_.info("asked " + owner + " again for " + std::to_string(wanted) + " missing slices");
+  return r;
+}
+
+std::vector<wire::ChunkRequest> PeerMaps::due(Clock::duration interval, Clock::time_point now) {
   std::vector<wire::ChunkRequest> out;
   for (auto& [id, p] : peers_) {
-    if (!p.incoming || p.features || p.incoming->refused()) continue;
+    if (!waiting(p)) continue;
     const auto quiet_since = std::max(p.last_progress, p.last_request);
-    if (!at_once && now - quiet_since < interval * (1 << std::min(p.unanswered, kMaxBackoffDoublings))) continue;
-    out.push_back(requestFor(id, p, /*everything=*/false, now));
-    p.last_request = now;
-    ++p.unanswered;
-    log_.info("asked " + id + " again for " + std::to_string(out.back().slices().size()) + " missing slices");
+    if (now - quiet_since < interval * (1 << std::min(p.unanswered, kMaxBackoffDoublings))) continue;
+    out.push_back(askAgain(id, p, now));
   }
   return out;
+}
+
+std::optional<wire::ChunkRequest> PeerMaps::askNow(const std::string& owner, Clock::time_point now) {
+  const auto it = peers_.find(owner);
+  if (it == peers_.end() || !waiting(it->second)) return std::nullopt;
+  return askAgain(owner, it->second, now);
 }
 
 std::shared_ptr<const MapFeatures> PeerMaps::features(const std::string& peer) const {

@@ -47,11 +47,16 @@ class PeerMaps {
   Received receive(const wire::SliceFeatures& s, size_t bytes, uint64_t sequence, Clock::time_point now);
 
   /// Requests for the maps still incomplete that have made no progress for
-  /// `interval` (all of them when `at_once`). Each request without progress
-  /// since doubles the wait before the next (up to 16 x): on a thin link a
-  /// transfer that is merely slow must not be asked for again and again,
-  /// since every resend reaches every receiver.
-  std::vector<wire::ChunkRequest> due(Clock::duration interval, bool at_once, Clock::time_point now);
+  /// `interval`. Each request without progress since doubles the wait before
+  /// the next (up to 16 x): on a thin link a transfer that is merely slow must
+  /// not be asked for again and again, since every resend reaches every
+  /// receiver.
+  std::vector<wire::ChunkRequest> due(Clock::duration interval, Clock::time_point now);
+  /// The request for `owner`'s map at once, if we still lack some of it: its
+  /// participant has just come, so what we asked it before may never have
+  /// reached it. Not the other owners: they heard us, and a request reaches
+  /// every receiver.
+  std::optional<wire::ChunkRequest> askNow(const std::string& owner, Clock::time_point now);
 
   std::shared_ptr<const MapFeatures> features(const std::string& peer) const;
   /// The latest version `peer` announced, held or not.
@@ -132,6 +137,10 @@ class PeerMaps {
   /// Builds a peer's map once every slice is in, and records the transfer.
   void complete(const std::string& owner, Peer& p);
   wire::ChunkRequest requestFor(const std::string& owner, const Peer& p, bool everything, Clock::time_point now) const;
+  /// Whether `p`'s map is announced, still incomplete, and not refused.
+  static bool waiting(const Peer& p);
+  /// The request for what `p` still lacks, counted as unanswered until progress.
+  wire::ChunkRequest askAgain(const std::string& owner, Peer& p, Clock::time_point now);
   /// Transfer rate so far [kbit/s]: bytes over the flow-control periods they
   /// took (the first period's budget leaves at once, so the time from the first
   /// to the last sample is one period short).

@@ -100,15 +100,34 @@ TEST(PeerMaps, ARequestSaysHowFarTheOwnersStreamWasTaken) {
   // but the fifth (written as number 5), and the last one taken is number 40.
   for (size_t i = 0; i < 40; ++i)
     if (i != 4) peers.receive(all[i], 1000, i + 1, t0 + 100ms);
-  const auto due = peers.due(1s, /*at_once=*/true, t0 + 200ms);
-  ASSERT_EQ(due.size(), 1u);
-  EXPECT_EQ(due.front().received_through(), 40u);
-  EXPECT_TRUE(std::count(due.front().slices().begin(), due.front().slices().end(), all[4].slice()))
+  const auto due = peers.askNow("bravo", t0 + 200ms);
+  ASSERT_TRUE(due);
+  EXPECT_EQ(due->received_through(), 40u);
+  EXPECT_TRUE(std::count(due->slices().begin(), due->slices().end(), all[4].slice()))
       << "the slice of the sample the reader lost is asked for";
 
   // A peer that comes again has a new writer, numbering from 1.
   peers.setAlive("bravo", true);
-  const auto again = peers.due(1s, /*at_once=*/true, t0 + 300ms);
-  ASSERT_EQ(again.size(), 1u);
-  EXPECT_EQ(again.front().received_through(), 0u);
+  const auto again = peers.askNow("bravo", t0 + 300ms);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->received_through(), 0u);
+}
+
+TEST(PeerMaps, APeerThatComesIsAskedForItsOwnMapAlone) {
+  Log log(LogLevel::Error);
+  PeerMaps peers("alpha", log, 256u << 20);
+  const auto& offer = bravoOffer();
+  const auto all = samplesOf(offer);
+  peers.announce(offer.announcement, t0);
+  // charlie's participant comes: nothing of charlie's is announced, and
+  // bravo, which heard our request, is not asked again on its account.
+  EXPECT_FALSE(peers.askNow("charlie", t0 + 100ms));
+  // bravo's participant comes (again): what we asked it may have been lost.
+  const auto asked_bravo = peers.askNow("bravo", t0 + 200ms);
+  ASSERT_TRUE(asked_bravo);
+  EXPECT_EQ(asked_bravo->owner(), "bravo");
+  EXPECT_EQ(asked(*asked_bravo), offer.announcement.slices().size()) << "every slice: none came yet";
+  for (size_t i = 0; i < all.size(); ++i) peers.receive(all[i], 1000, i + 1, t0 + 300ms);
+  ASSERT_TRUE(peers.features("bravo"));
+  EXPECT_FALSE(peers.askNow("bravo", t0 + 400ms)) << "a complete map is not asked for";
 }
