@@ -80,6 +80,7 @@ void Agent::installOwnMap(OwnMap own) {
       tiltText(*own_features_) + "; described in " + fixed(own.seconds, 2) + " s");
   if (bus_) {
     bus_->publish(a);
+    reannounce_ = false;  // every peer that asked gets this one
     persist(false);
   }
 }
@@ -172,6 +173,10 @@ void Agent::onSlice(wire::SliceFeatures&& s, size_t bytes, uint64_t sequence) {
 void Agent::onRequest(wire::ChunkRequest&& r) {
   if (r.requester().to_string() == config_.agent() || r.owner().to_string() != config_.agent()) return;
   if (!fromKnown(r.requester().to_string(), "a request")) return;
+  // A request for another version (PeerMaps::kNoVersion: none) comes from a
+  // peer that lacks our current announcement. While our map loads there is
+  // none: the first goes to every peer when it is ready.
+  if (offering() && r.version() != sender_.version()) reannounce_ = true;
   const size_t resent = sender_.resends();
   const size_t wanted = sender_.request(r.requester().to_string(), r.version(), r.slices(),
                                         std::chrono::milliseconds(r.stalled_ms()), Clock::now(), r.received_through());
@@ -224,12 +229,10 @@ void Agent::onPeer(const std::string& id, bool alive) {
     if (peers_.setAlive(id, true)) log_.info("peer " + id + " is up");
     board_.agentUp(id);
     if (auto r = peers_.askNow(id, Clock::now())) bus_->publish(*r);  // what we asked it before was lost
-    // Durability is meant to give it our announcement, but Fast DDS misses a
-    // late reader now and then (eProsima/Fast-DDS#3822): announce again soon,
-    // unless it asks for our slices first. A peer that comes up again may have
-    // restarted without it.
+    // Durability gives it our announcement, or it asks for it (PeerMaps::due):
+    // Fast DDS misses a late reader now and then (eProsima/Fast-DDS#3822). A
+    // peer that comes up again may have restarted without it.
     sender_.forget(id);
-    reannounce_ = true;
     // A late joiner gets what this agent computed, in case durability missed it.
     for (const auto* held : {&board_.results(), &board_.keptBeside()})
       for (const auto& [key, t] : *held)

@@ -156,7 +156,7 @@ class Agent {
   bool transforms_unwritten_ = false;  ///< transforms.json is behind: its last write failed
   std::string write_error_;            ///< why the last write of a state file failed; empty once one succeeds
   RejectionLog rejections_;            ///< warnings for rejected samples, bounded per sender
-  bool reannounce_ = false;            ///< a peer appeared: announce again (tick, once for peers that come together)
+  bool reannounce_ = false;            ///< a peer asked for our announcement: announce again (tick, once for peers that ask together)
   Clock::time_point started_ = Clock::now();
 };
 

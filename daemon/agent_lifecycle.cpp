@@ -13,7 +13,7 @@ namespace {
 
 constexpr auto kTick = std::chrono::milliseconds(50);
 constexpr auto kReannounce = std::chrono::seconds(30);
-constexpr auto kReannounceAfterPeer = std::chrono::seconds(3);
+constexpr auto kReannounceGap = std::chrono::seconds(3);  ///< between announcements peers asked for
 constexpr auto kStatusEvery = std::chrono::seconds(1);
 /// A map file must be quiet this long before it is read: writers that open,
 /// write and close it several times are done by then.
@@ -138,12 +138,11 @@ void Agent::tick(Clock::time_point& last_announce) {
   requestMissing();
   claimAndCompute();
   for (const auto& line : rejections_.due(now)) log_.warning(line);
-  // Repairs a lost or missed announcement. After a peer appeared, once, a
-  // little later: peers that appear together get one announcement, since each
-  // reaches every receiver. Not while every live peer has shown it holds it
-  // (it asked for our slices): each copy goes to every peer, some 1.2 kB
-  // each with a hundred slices.
-  const bool due = now - last_announce > kReannounce || (reannounce_ && now - last_announce > kReannounceAfterPeer);
+  // Repairs a lost or missed announcement: when a peer asked for it (once
+  // for peers that ask together, since each copy reaches every receiver),
+  // and every kReannounce. Not while every live peer has shown it holds it (it
+  // asked for our slices): some 2 kB a receiver with a hundred slices.
+  const bool due = now - last_announce > kReannounce || (reannounce_ && now - last_announce > kReannounceGap);
   if (due && offering()) {
     reannounce_ = false;
     last_announce = now;

@@ -62,7 +62,7 @@ class MapSender {
   /// kMatchWait.
   bool mayStart(size_t matched_readers, size_t alive_peers, Clock::time_point now);
 
-  /// Hands queued parts to `publish` in order, paced at the stream's rate for
+  /// Hands queued samples to `publish` in order, paced at the stream's rate for
   /// new samples and at most kFeedAhead ahead of `now`, until it refuses one
   /// (returns 0: the writer is full): the rest goes on later calls. `publish`
   /// returns the sample's sequence number; `size` gives its bytes on the wire.
@@ -72,7 +72,7 @@ class MapSender {
   size_t queued() const { return queue_.size(); }
   size_t bytesSent() const { return bytes_sent_; }
   size_t samplesSent() const { return samples_sent_; }
-  /// Slices written again because a requester's copy was overdue.
+  /// Samples written again because a requester's copy was overdue.
   size_t resends() const { return resends_; }
 
  private:
@@ -96,22 +96,21 @@ class MapSender {
   static constexpr Clock::duration kMatchWait = std::chrono::seconds(5);
 
   Clock::duration leaveTime(size_t bytes) const;
-  size_t sliceBytes(int slice) const;  ///< payload bytes of a slice, as announced
+  size_t bundleBytes(size_t bundle) const;  ///< serialized bytes of a written sample
 
   double kbps_;
   Clock::duration grace_;
   transport::MapOffer offer_;
-  std::deque<int> queue_;  ///< slices to send, in order
-  std::set<int> queued_;
-  size_t next_part_ = 0;  ///< part of queue_.front() to send next
+  std::deque<size_t> queue_;  ///< samples to send (indices into offer_.bundles), in order
+  std::set<size_t> queued_;
   /// When the flow controller will have sent everything handed to it so far,
-  /// and when each written slice's last copy leaves it.
+  /// and when each written sample's last copy leaves it.
   Clock::time_point backlog_until_{};
   struct Written {
     Clock::time_point leaves{};  ///< when its last copy leaves the controller
-    uint64_t sequence = 0;       ///< the writer's sequence number of its last part
+    uint64_t sequence = 0;       ///< the writer's sequence number of its last copy
   };
-  std::map<int, Written> written_;
+  std::map<size_t, Written> written_;
   /// Per requester: until when copies already written may still be on their
   /// way to it (a late reader gets the history after the backlog).
   std::map<std::string, Clock::time_point> expected_until_;

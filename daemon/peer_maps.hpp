@@ -50,8 +50,13 @@ class PeerMaps {
   /// `interval`. Each request without progress since doubles the wait before
   /// the next (up to 16 x): on a thin link a transfer that is merely slow must
   /// not be asked for again and again, since every resend reaches every
-  /// receiver.
+  /// receiver. And, to a live peer whose announcement has not come within
+  /// kAnnouncementWait (durability misses a late reader now and then, Fast
+  /// DDS #3822, and a restarted peer lost it), a request of version 0: "your
+  /// announcement, please", backing off alike.
   std::vector<wire::ChunkRequest> due(Clock::duration interval, Clock::time_point now);
+  /// The version a request names when the requester holds no announcement of the owner's.
+  static constexpr uint64_t kNoVersion = 0;
   /// The request for `owner`'s map at once, if we still lack some of it: its
   /// participant has just come, so what we asked it before may never have
   /// reached it. Not the other owners: they heard us, and a request reaches
@@ -77,11 +82,14 @@ class PeerMaps {
     for (auto it = early_.begin(); it != early_.end();) it = keep(it->first) ? std::next(it) : early_.erase(it);
     for (auto it = received_through_.begin(); it != received_through_.end();)
       it = keep(it->first) ? std::next(it) : received_through_.erase(it);
+    for (auto it = unannounced_.begin(); it != unannounced_.end();)
+      it = keep(it->first) ? std::next(it) : unannounced_.erase(it);
   }
   /// Every peer gone (this agent left the network): sequence numbers start anew too.
   void clearAlive() {
     alive_.clear();
     received_through_.clear();
+    unannounced_.clear();
   }
 
   /// Progress over every peer: maps complete, slices received and announced.
@@ -156,6 +164,13 @@ class PeerMaps {
   std::map<std::string, uint64_t> received_through_;
   std::map<std::string, std::deque<Transfer>> transfers_;  ///< finished transfers per peer, latest last
   std::set<std::string> alive_;
+  /// Live peers whose announcement has not come: since when (or since the
+  /// last ask), and how many times asked.
+  struct Unannounced {
+    Clock::time_point since{};
+    int asked = 0;
+  };
+  std::map<std::string, Unannounced> unannounced_;
   std::map<std::string, uint64_t> last_seen_ms_;
 };
 

@@ -16,6 +16,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "bundling.hpp"
 #include "egress_pacer.hpp"
 #include "senders.hpp"
 #include "tomomapPubSubTypes.h"
@@ -247,8 +248,11 @@ Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<
     i.slices = i.addTopic<wire::SliceFeaturesPubSubType, wire::SliceFeatures>(
         "tomomap/slices", {true, false, 1, 0, kSliceInstances},
         [on = h.slice](wire::SliceFeatures&& s, uint64_t sequence) {
-          const size_t bytes = serializedSize(s);
-          if (on) on(std::move(s), bytes, sequence);
+          if (!on) return;
+          for (auto& piece : unbundle(std::move(s))) {
+            const size_t bytes = serializedSize(piece);
+            on(std::move(piece), bytes, sequence);
+          }
         },
         /*flow_controlled=*/true);
     // Requests: best effort, since a receiver repeats them while it lacks

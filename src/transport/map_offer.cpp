@@ -7,6 +7,7 @@
 #include <cstring>
 #include <set>
 
+#include "bundling.hpp"
 #include "core/dense_search.hpp"
 #include "slice_encoding.hpp"
 
@@ -119,7 +120,46 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const Feature
   a.version(mapVersion(a));
   for (auto& [k, samples] : offer.samples)
     for (auto& x : samples) x.version(a.version());
+  offer.sample_bytes = max_sample_bytes;
+  bundleOffer(offer);
   return offer;
+}
+
+void bundleOffer(MapOffer& offer, const wire::MapAnnouncement* previous) {
+  const std::set<int> kept = previous ? unchangedSlices(offer.announcement, *previous) : std::set<int>{};
+  std::vector<wire::SliceFeatures> pieces;
+  std::vector<int> slice_of, group;
+  for (const auto& e : offer.announcement.slices()) {
+    const auto it = offer.samples.find(e.slice());
+    if (it == offer.samples.end()) continue;
+    for (const auto& p : it->second)
+      pieces.push_back(p), slice_of.push_back(e.slice()), group.push_back(kept.count(e.slice()) ? 1 : 0);
+  }
+  Bundles b = bundle(pieces, offer.sample_bytes, group);
+  offer.bundles = std::move(b.samples);
+  offer.bundles_of.clear();
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    auto& homes = offer.bundles_of[slice_of[i]];
+    if (std::find(homes.begin(), homes.end(), b.home[i]) == homes.end()) homes.push_back(b.home[i]);
+  }
+}
+
+std::set<int> unchangedSlices(const wire::MapAnnouncement& now, const wire::MapAnnouncement& then) {
+  std::set<int> kept;
+  const bool same_raster = now.agent() == then.agent() && now.grid() == then.grid() && now.x_min() == then.x_min() &&
+                           now.y_min() == then.y_min() && now.z_min() == then.z_min() &&
+                           now.width() == then.width() && now.height() == then.height() &&
+                           now.features() == then.features();
+  if (!same_raster) return kept;  // every cell index (or feature) means something else now
+  std::map<int, const wire::SliceEntry*> before;
+  for (const auto& e : then.slices()) before[e.slice()] = &e;
+  for (const auto& e : now.slices()) {
+    const auto old = before.find(e.slice());
+    if (old != before.end() && old->second->crc32() == e.crc32() && old->second->bytes() == e.bytes() &&
+        old->second->parts() == e.parts())
+      kept.insert(e.slice());
+  }
+  return kept;
 }
 
 uint64_t mapVersion(const wire::MapAnnouncement& a) {

@@ -3,6 +3,7 @@
 // settings, every slice's size and CRC, and a version hashed over all of it)
 // and every slice cut into samples that fit the bandwidth budget.
 #include <map>
+#include <set>
 #include <vector>
 
 #include "core/features.hpp"
@@ -15,7 +16,26 @@ struct MapOffer {
   wire::MapAnnouncement announcement;
   std::map<int, std::vector<wire::SliceFeatures>> samples;  ///< by slice index, parts in order
   size_t payload_bytes = 0;                                 ///< sum of the slices' payload bytes
+  /// What is written: every part above, small ones riding in others' spare
+  /// room (bundling.hpp), in the announcement's order; and the ones that carry
+  /// each slice's parts.
+  std::vector<wire::SliceFeatures> bundles;
+  std::map<int, std::vector<size_t>> bundles_of;
+  size_t sample_bytes = 0;  ///< the most a sample may take, serialized
 };
+
+/// Fills `offer.bundles` and `offer.bundles_of` from its samples. With the
+/// `previous` version's announcement, pieces of slices a holder of it keeps
+/// (unchangedSlices) and pieces of the others never share a sample: after a
+/// map update peers ask for the changed slices only, and a sample mixing both
+/// would send kept slices again (a demo-room update that changed a third of
+/// the slices resent more than the whole first transfer).
+void bundleOffer(MapOffer& offer, const wire::MapAnnouncement* previous = nullptr);
+
+/// The slices of `now` that a holder of `then` keeps: both of the same agent,
+/// raster and feature settings, and the slice's index, bytes, parts and CRC
+/// unchanged (docs/protocol.md, "A map that changes").
+std::set<int> unchangedSlices(const wire::MapAnnouncement& now, const wire::MapAnnouncement& then);
 
 /// Slices `features` (its occupancy must be present; `params` are the ones it
 /// was extracted with) into samples of at most `max_sample_bytes` each. Each

@@ -87,20 +87,10 @@ std::vector<int32_t> Reassembler::missing() const {
 }
 
 size_t Reassembler::adopt(const Reassembler& earlier) {
-  const auto& a = announcement_;
-  const auto& b = earlier.announcement_;
-  const bool same_raster = a.agent() == b.agent() && a.grid() == b.grid() && a.x_min() == b.x_min() &&
-                           a.y_min() == b.y_min() && a.z_min() == b.z_min() && a.width() == b.width() &&
-                           a.height() == b.height() && a.features() == b.features();
-  if (!same_raster) return 0;  // every cell index (or feature) means something else now
   size_t taken = 0;
-  for (const auto& [index, position] : entries_) {
-    const auto old = earlier.entries_.find(index);
+  for (int index : unchangedSlices(announcement_, earlier.announcement_)) {
     const auto parts = earlier.done_.find(index);
-    if (done_.count(index) || old == earlier.entries_.end() || parts == earlier.done_.end()) continue;
-    const wire::SliceEntry& now = a.slices()[position];
-    const wire::SliceEntry& then = b.slices()[old->second];
-    if (now.crc32() != then.crc32() || now.bytes() != then.bytes() || now.parts() != then.parts()) continue;
+    if (done_.count(index) || parts == earlier.done_.end()) continue;
     done_[index] = parts->second;
     if (const auto cells = earlier.cells_.find(index); cells != earlier.cells_.end()) {
       cells_[index] = cells->second;

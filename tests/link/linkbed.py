@@ -67,9 +67,9 @@ class Impairment:
 SUBMESSAGES = {0x06: "ACKNACK", 0x07: "HEARTBEAT", 0x08: "GAP", 0x09: "INFO_TS", 0x0e: "INFO_DST",
                0x12: "NACK_FRAG", 0x13: "HEARTBEAT_FRAG", 0x15: "DATA", 0x16: "DATA_FRAG", 0x31: "SEC_BODY",
                0x32: "SEC_PREFIX", 0x33: "SEC_POSTFIX", 0x34: "SRTPS_PREFIX", 0x35: "SRTPS_POSTFIX"}
-# Entity ids (writer of DATA, DATA_FRAG, HEARTBEAT, GAP; reader of ACKNACK, NACK_FRAG) at these byte offsets
-# into the submessage.
-ENTITY_OFFSET = {0x15: 12, 0x16: 12, 0x07: 12, 0x13: 12, 0x08: 12, 0x06: 8, 0x12: 8}
+# The entity id of the writer each submessage is about (it sends DATA, DATA_FRAG, HEARTBEAT, GAP; its readers
+# answer with ACKNACK, NACK_FRAG), at this byte offset into the submessage.
+ENTITY_OFFSET = {0x15: 12, 0x16: 12, 0x07: 8, 0x13: 8, 0x08: 8, 0x06: 8, 0x12: 8}
 
 
 def describe_packet(packet):

@@ -31,6 +31,7 @@ transport::MapOffer fakeOffer(int slices, int parts, uint64_t version) {
       o.samples[k].push_back(s);
     }
   }
+  transport::bundleOffer(o);  // sample_bytes 0: no sample has room for another, one part a sample
   return o;
 }
 
@@ -65,7 +66,7 @@ TEST(MapSender, SendsWhatWasAskedForOnceInOrder) {
   m.setOffer(fakeOffer(3, 2, 9));
   EXPECT_EQ(m.request("bravo", 9, {2, 0}, kStalled, t0), 2u);
   EXPECT_EQ(m.request("bravo", 9, {0}, kStalled, t0), 1u) << "asked twice before it left: queued once";
-  EXPECT_EQ(m.queued(), 2u);
+  EXPECT_EQ(m.queued(), 4u) << "two samples a slice";
   Wire w;
   w.take(m, t0);
   EXPECT_EQ(w.sent, (std::vector<std::pair<int, int>>{{2, 0}, {2, 1}, {0, 0}, {0, 1}}));
@@ -103,8 +104,8 @@ TEST(MapSender, ASliceTheRequestersReaderHasPassedIsSentAgainAtOnce) {
   // taken samples up to number 5: its reader delivers in order, so slice 1
   // (last written as 4) will not come; slice 2's last part (6) may.
   m.request("bravo", 9, {1, 2}, 2s, t0 + 2s, /*received_through=*/5);
-  EXPECT_EQ(m.queued(), 1u);
-  EXPECT_EQ(m.resends(), 1u);
+  EXPECT_EQ(m.queued(), 2u) << "slice 1's two samples";
+  EXPECT_EQ(m.resends(), 2u);
   w.take(m, t0 + 2s);
   EXPECT_EQ(w.sent.back(), std::make_pair(1, 1));
   // The same request again: slice 1's new copy (7, 8) is on its way.
@@ -222,4 +223,21 @@ TEST(MapSender, APeerThatAskedForTheCurrentVersionHoldsItsAnnouncement) {
   s.request("bravo", 7, {}, 0s, now);
   s.setOffer(fakeOffer(3, 1, 8));
   EXPECT_FALSE(s.informed({"bravo"})) << "a new version is news to everyone";
+}
+
+TEST(MapSender, ARequestForASliceThatRidesInAnotherSampleSendsThatSample) {
+  MapSender m(80, 1s);
+  transport::MapOffer o = fakeOffer(3, 1, 9);
+  o.sample_bytes = 1000;  // three empty parts fit one sample
+  transport::bundleOffer(o);
+  ASSERT_EQ(o.bundles.size(), 1u);
+  m.setOffer(o);
+  EXPECT_EQ(m.request("bravo", 9, {2, 1}, kStalled, t0), 2u);
+  EXPECT_EQ(m.queued(), 1u);
+  Wire w;
+  w.take(m, t0);
+  EXPECT_EQ(w.sent, (std::vector<std::pair<int, int>>{{0, 0}})) << "slice 0's sample, with slices 1 and 2 riding";
+  // Slice 0 is in that sample too: asked for now, it is on its way.
+  m.request("bravo", 9, {0}, kStalled, t0 + 1s);
+  EXPECT_EQ(m.queued(), 0u);
 }

@@ -131,3 +131,26 @@ TEST(PeerMaps, APeerThatComesIsAskedForItsOwnMapAlone) {
   ASSERT_TRUE(peers.features("bravo"));
   EXPECT_FALSE(peers.askNow("bravo", t0 + 400ms)) << "a complete map is not asked for";
 }
+
+TEST(PeerMaps, ALivePeerWhoseAnnouncementDoesNotComeIsAskedForItWithBackOff) {
+  Log log(LogLevel::Error);
+  PeerMaps peers("alpha", log, 256u << 20);
+  peers.setAlive("bravo", true);
+  auto announcementAsks = [&](Clock::time_point at) {
+    size_t n = 0;
+    for (const auto& r : peers.due(1s, at))
+      if (r.owner() == "bravo" && r.version() == PeerMaps::kNoVersion && r.requester() == "alpha") ++n;
+    return n;
+  };
+  EXPECT_EQ(announcementAsks(t0), 0u) << "durability brings it within a second or two";
+  EXPECT_EQ(announcementAsks(t0 + 4s), 0u);
+  EXPECT_EQ(announcementAsks(t0 + 5100ms), 1u);
+  EXPECT_EQ(announcementAsks(t0 + 14s), 0u) << "the next ask waits twice as long";
+  EXPECT_EQ(announcementAsks(t0 + 15200ms), 1u);
+  // The announcement comes: no more asking for it.
+  peers.announce(bravoOffer().announcement, t0 + 16s);
+  EXPECT_EQ(announcementAsks(t0 + 60s), 0u);
+  // bravo restarts: its new participant is waited for, then asked, anew.
+  peers.setAlive("bravo", false);
+  EXPECT_EQ(announcementAsks(t0 + 61s), 0u) << "not alive";
+}
