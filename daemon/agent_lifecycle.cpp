@@ -219,7 +219,13 @@ int Agent::run(Signals& signals) {
       queue_cv_.wait_for(lock, kTick, [this] { return !queue_.empty() || worker_.ready(); });
       work.swap(queue_);
     }
-    for (auto& w : work) w();
+    // A stop is not held up by a long batch (a received map's slices under
+    // load): what is left undone is asked for again after a restart.
+    for (auto& w : work) {
+      if (signals.stop) break;
+      w();
+    }
+    if (signals.stop) break;
     {
       // Decide on claims only with every received event applied: work above
       // may have taken long (ORB on a received map) while claims arrived.

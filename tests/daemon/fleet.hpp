@@ -182,13 +182,24 @@ inline int matchesComputed(const Fleet& fleet, const std::vector<std::string>& i
   return n;
 }
 
-/// Stops every agent with SIGTERM and checks each leaves within 2 s, cleanly.
+/// How long systemd waits for tomomapd to stop after SIGTERM before killing
+/// it (TimeoutStopSec in the shipped unit): the deadline a stop must meet.
+inline std::chrono::milliseconds stopTimeout() {
+  std::ifstream unit(TOMOMAP_SOURCE_DIR "/daemon/tomomapd.service.in");
+  const std::string key = "TimeoutStopSec=";
+  for (std::string line; std::getline(unit, line);)
+    if (line.rfind(key, 0) == 0) return std::chrono::seconds(std::stoi(line.substr(key.size())));
+  ADD_FAILURE() << "no " << key << " in daemon/tomomapd.service.in";
+  return std::chrono::seconds(10);
+}
+
+/// Stops every agent with SIGTERM and checks each leaves cleanly within the
+/// unit's stop timeout.
 inline void stopAll(Fleet& fleet, const std::vector<std::string>& ids) {
-  using namespace std::chrono_literals;
   for (const auto& id : ids) fleet.kill(id, SIGTERM);
   for (const auto& id : ids) {
-    const auto code = fleet.waitExit(id, 2000ms);
-    ASSERT_TRUE(code.has_value()) << id << " did not stop within 2 s\n" << fleet.log(id);
+    const auto code = fleet.waitExit(id, stopTimeout());
+    ASSERT_TRUE(code.has_value()) << id << " did not stop within TimeoutStopSec\n" << fleet.log(id);
     EXPECT_EQ(*code, 0) << fleet.log(id);
     EXPECT_NE(fleet.log(id).find("stopped"), std::string::npos);
   }

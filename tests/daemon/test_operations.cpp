@@ -183,8 +183,8 @@ TEST(Operations, NotifiesSystemdReloadsOnSighupAndStopsCleanly) {
   EXPECT_FALSE(fleet.waitExit("alpha", 500ms).has_value()) << "still running";
 
   fleet.kill("alpha", SIGTERM);
-  const auto code = fleet.waitExit("alpha", 2000ms);
-  ASSERT_TRUE(code.has_value()) << "stops within 2 s";
+  const auto code = fleet.waitExit("alpha", stopTimeout());
+  ASSERT_TRUE(code.has_value()) << "stops within the unit's TimeoutStopSec";
   EXPECT_EQ(*code, 0);
   EXPECT_TRUE(notify.waitFor("STOPPING=1", 5s)) << notify.all();
   EXPECT_EQ(fleet.readJson("alpha", "status.json")["agent"], "alpha");
