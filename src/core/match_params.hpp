@@ -33,8 +33,9 @@ struct MatchParams {
 /// absolute margin (another answer within min_support pairs, matcher.cpp)
 /// rather than by a share of its support; the indexed search follows rivals
 /// by that margin (offset_search.cpp), and on small maps the dense search
-/// checks a weak winner however far it leads (a noise-free room at g 0.05
-/// came out reliable and half-turned at 7 slice pairs against 3).
+/// checks every answer whose lead over its runner-up is weak by this measure
+/// (rooms came out reliable and wrong at 7 slice pairs against 3 and at 15
+/// against 5; matcher.cpp).
 inline bool weakWinner(int support, const MatchParams& params) { return support < 5 * params.min_support; }
 
 /// Called with (stage name, done, total) as work advances; may be empty.

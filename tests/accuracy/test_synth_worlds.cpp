@@ -131,3 +131,22 @@ TEST(SmallRooms, ADenseSearchShortOfAnsweringStillRefusesAFeatureAnswerItContrad
   const RoomMatch m = matchRoom(14, "high", 0.05);
   EXPECT_FALSE(m.answeredWrong(0.05)) << wrongAnswer(m);
 }
+
+// With high noise at g 0.05 the features answered 33 of 340 room pairs (seeds
+// 1-200 at low and high noise), 10 of them wrong: half-turned, or one
+// enclosure laid on a similar one. The dense search's best pose was another
+// one (seeds 112, 177), or the same one but too close to its next to tell
+// (93, 108: 1.02-1.04x); seed 11 led 15 slice pairs to 5 and was not asked.
+// An answer the dense search does not confirm is refused; one it confirms
+// (seed 122, 1.70x) stands.
+TEST(SmallRooms, AFeatureAnswerTheDenseSearchDoesNotConfirmIsRefused) {
+  for (const uint64_t seed : {11, 93, 108, 112, 177}) {
+    const RoomMatch m = matchRoom(seed, "high", 0.05);
+    EXPECT_GT(m.result.dense_lead, 0.0) << "seed " << seed << ": the dense search did not run";
+    EXPECT_FALSE(m.answeredWrong(0.05)) << "seed " << seed << " " << wrongAnswer(m);
+  }
+  const RoomMatch confirmed = matchRoom(122, "high", 0.05);
+  EXPECT_TRUE(confirmed.result.reliable && confirmed.right(0.05))
+      << confirmed.result.reason << " " << confirmed.error.translation << " m off";
+  EXPECT_EQ(confirmed.result.method, "features");
+}
