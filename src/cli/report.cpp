@@ -66,8 +66,8 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
         "quality          support %d slice pairs (runner-up %d), %zu inliers, spread x %.2f y %.2f z %.2f m\n",
         r.support, r.runner_up_support, r.inliers, r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z());
     if (r.dense_lead > 0)
-      out << format("dense search     %s; its best pose has %.2fx the telling cells of the next\n",
-                    r.method == "dense" ? "found this answer (the features found none)" : "ran beside the features",
+      out << format("dense search     %s; at %.2f m cells its best pose has %.2fx the telling cells of the next\n",
+                    r.method == "dense" ? "found this answer" : "ran beside the features", r.dense_cell,
                     r.dense_lead);
     out << "tilt             target " << tiltText(r.target_tilt) << ", source " << tiltText(r.source_tilt) << "\n";
     out << format(
@@ -101,6 +101,7 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
   j["tilt_deg"] = {{"target", tiltJson(r.target_tilt)}, {"source", tiltJson(r.source_tilt)}};
   j["quality"] = {{"method", r.method},
                   {"dense_lead", r.dense_lead},
+                  {"dense_cell", r.dense_cell},
                   {"support", r.support},
                   {"height_offset_slices", r.height_offset},
                   {"runner_up_support", r.runner_up_support},

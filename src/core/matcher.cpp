@@ -5,7 +5,7 @@
 #include <future>
 #include <optional>
 
-#include "dense_search.hpp"
+#include "dense_opinion.hpp"
 #include "height_offsets.hpp"
 #include "map_check.hpp"
 #include "offset_search.hpp"
@@ -71,88 +71,50 @@ void judge(MatchResult& r, const MatchParams& params) {
     r.reliable = true;
 }
 
-/// The dense search's winner must have this many times the telling cells of
-/// its best other pose. Room pairs (synth -w room, seeds 1-10, every noise, g
-/// 0.1 and 0.05): wrong winners led by 1.00-1.33, right ones by 1.04-3.37;
-/// 38 of the 54 right ones lead by 1.4 or more (docs/results.md, "Small rooms").
-constexpr double kDenseLead = 1.4;
-/// A feature answer on a small map stands only where the dense search's best
-/// pose is this far ahead of its next (with `min_support` slices) and is the
-/// same pose; a best pose that far ahead elsewhere refuses it (or, at
-/// kDenseLead, replaces it), and so does one too close to its next to tell.
-/// Of 820 room pairs (seeds 1-200 at low and high noise, 1-10 noise-free;
-/// g 0.1 and 0.05) the features answered 33, 10 of them wrong: the dense
-/// search confirmed none of the 10 (its best pose elsewhere, or at most 1.08x
-/// ahead) and 17 of the 23 right ones (1.22x and more). docs/results.md,
-/// "Small rooms".
-constexpr double kDenseOpinion = 1.2;
-
-/// Small maps get a second opinion that needs no features: on a room, few
-/// slices and a 31-pixel ORB patch spanning most of the image leave the
-/// tomographic match refusing or, with noisy walls, fooled by a half-turned
-/// room or by one enclosure laid on a similar one, however far its winner
-/// leads (15 slice pairs against 5), while the occupancy itself still tells
-/// the right pose apart. A feature answer the dense search does not confirm is
-/// refused, or replaced where the dense search clearly found another pose; so
-/// is a refused one. Larger maps are not searched.
-void consultDenseSearch(MatchResult& r, const MapFeatures& target, const MapFeatures& source,
-                        const MatchParams& params) {
-  // A feature answer that leads its runner-up by as many slice pairs as a
-  // strong winner has needs no second opinion (and its maps, no extra
-  // 0.1-0.9 s): demo-room leads 29 to 1; of the room answers the check
-  // overturned, the widest lead was 15 to 5.
-  if (r.reliable && !weakWinner(r.support - r.runner_up_support, params)) return;
-  const auto t0 = Clock::now();
-  DenseSearchParams dp;
-  dp.threads = matchThreads(params);
-  const ConsensusParams same{params.consensus_translation_cells * target.grid, params.consensus_yaw};
-  const DenseSearch d = searchDensely(target.occupancy, source.occupancy, same, source.centre(), dp);
-  r.timings.dense = secondsSince(t0);
-  if (!d.searched || d.poses.empty()) return;
-  const DensePose& best = d.poses.front();
-  const size_t next = d.poses.size() > 1 ? d.poses[1].telling_inliers : 0;
-  r.dense_lead = static_cast<double>(best.telling_inliers) / static_cast<double>(std::max<size_t>(next, 1));
-  const auto leadsBy = [&](double lead) { return r.dense_lead >= lead && best.support >= params.min_support; };
-  const bool clear = leadsBy(kDenseLead);
-  if (r.reliable) {
-    const Rigid2D features{r.T_target_source.yaw, {r.T_target_source.x, r.T_target_source.y}};
-    const bool same_pose = std::abs(best.offset - r.height_offset) <= kSmearSlices / 2 &&
-                           agree(features, best.transform, same, source.centre());
-    if (leadsBy(kDenseOpinion) && same_pose) return;  // confirmed
-    if (!clear) {
-      r.reliable = false;
-      if (!leadsBy(kDenseOpinion))
-        r.reason = "a dense search of the occupancy does not confirm the features' answer (its best pose leads by " +
-                   fixed(r.dense_lead, 2) + "x with " + std::to_string(best.support) + " slices; need " +
-                   fixed(kDenseOpinion, 2) + "x and " + std::to_string(params.min_support) + ")";
-      else
-        r.reason = "the features and a dense search of the occupancy disagree (" + fixed(r.dense_lead, 2) +
-                   "x lead for a pose " + fixed((best.transform.t - features.t).norm(), 2) + " m, " +
-                   fixed(degrees(std::abs(wrapAngle(best.transform.yaw - features.yaw))), 1) + " deg and " +
-                   fixed(std::abs(best.offset - r.height_offset) * target.grid, 2) + " m in height away)";
-      return;
-    }
-    // A clear dense pose elsewhere replaces the features' answer, as it
-    // replaces a refused one: on the 820 room pairs it did so 11 times, each
-    // right (0.003-0.105 m off), where the features had led by a few pairs.
-  } else if (!clear) {
-    r.reason += "; nor did a dense search of the occupancy find a clear pose (lead " + fixed(r.dense_lead, 2) +
-                "x, need " + fixed(kDenseLead, 2) + "x)";
+/// The tomographic match of two maps' feature stacks, judged: into `r`.
+void matchSlices(MatchResult& r, const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
+                 const Progress& progress, PairCache* cache) {
+  const size_t nt = target.slices.size(), ns = source.slices.size();
+  if (nt < static_cast<size_t>(params.min_support) || ns < static_cast<size_t>(params.min_support)) {
+    r.reason = "too few descriptive slices (target " + std::to_string(nt) + ", source " + std::to_string(ns) +
+               "; need " + std::to_string(params.min_support) + ")";
     return;
   }
-  r.method = "dense";
-  r.reliable = true;
-  r.reason.clear();
-  r.T_target_source = {best.transform.t.x(), best.transform.t.y(),
-                       target.z_min - source.z_min + best.offset * target.grid, wrapAngle(best.transform.yaw)};
-  if (target.leveled || source.leveled) r.T_target_source_unleveled = unleveled(r.T_target_source, target, source);
+  auto t0 = Clock::now();
+  const SlicePairTable pairs = matchSlicePairs(target, source, params, progress, cache);
+  if (cache) cache->keep(pairs, params);
+  r.slice_pairs = pairs.matchedCount();
+  r.slice_pairs_total = nt * ns;
+  r.slice_pairs_recalled = pairs.recalled;
+  r.timings.pair_matching = secondsSince(t0);
+
+  t0 = Clock::now();
+  const std::vector<OffsetScore> scores = scoreOffsets(pairs, target, source, params);
+  const OffsetChoice choice = pickOffset(scores, params, source.centre());
+  r.timings.consensus = secondsSince(t0);
+  if (!choice.best) {
+    r.reason = "no slice pair produced an estimate";
+    return;
+  }
+  const OffsetScore& best = *choice.best;
+  r.runner_up_support = choice.runner_up_support;
+  r.runner_up_offset = choice.runner_up_offset;
+  r.support = static_cast<int>(best.consensus.support());
   r.height_offset = best.offset;
-  r.support = best.support;
-  r.runner_up_support = d.poses.size() > 1 ? d.poses[1].support : 0;
-  r.runner_up_offset = d.poses.size() > 1 ? d.poses[1].offset : 0;
-  r.supporters.clear();
-  r.inliers = best.inliers;
-  r.inlier_spread = Eigen::Vector3d::Zero();
+  for (size_t k : best.consensus.supporters)
+    r.supporters.push_back({target.slices[k / ns].index, source.slices[k % ns].index, pairs.estimates[k].inliers});
+  std::stable_sort(r.supporters.begin(), r.supporters.end(),
+                   [](const SupportingPair& x, const SupportingPair& y) { return x.inliers > y.inliers; });
+
+  t0 = Clock::now();
+  const Refined refined = refineOffset(pairs, target, source, best.offset, best.consensus.mean, params);
+  r.timings.refinement = secondsSince(t0);
+
+  r.T_target_source = {refined.T.t.x(), refined.T.t.y(), target.z_min - source.z_min + best.offset * target.grid,
+                       wrapAngle(refined.T.yaw)};
+  r.inliers = refined.inliers.size();
+  r.inlier_spread = inlierSpread(refined);
+  judge(r, params);
 }
 
 }  // namespace
@@ -218,52 +180,9 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   if (std::abs(target.grid - source.grid) > 1e-9)
     throw InputError("feature sets use different grid sizes (" + std::to_string(target.grid) + " and " +
                      std::to_string(source.grid) + " m)");
-  const size_t nt = target.slices.size(), ns = source.slices.size();
-  if (nt < static_cast<size_t>(params.min_support) || ns < static_cast<size_t>(params.min_support)) {
-    r.reason = "too few descriptive slices (target " + std::to_string(nt) + ", source " + std::to_string(ns) +
-               "; need " + std::to_string(params.min_support) + ")";
-    consultDenseSearch(r, target, source, params);
-    return r;
-  }
-
-  auto t0 = Clock::now();
-  const SlicePairTable pairs = matchSlicePairs(target, source, params, progress, cache);
-  if (cache) cache->keep(pairs, params);
-  r.slice_pairs = pairs.matchedCount();
-  r.slice_pairs_total = nt * ns;
-  r.slice_pairs_recalled = pairs.recalled;
-  r.timings.pair_matching = secondsSince(t0);
-
-  t0 = Clock::now();
-  const std::vector<OffsetScore> scores = scoreOffsets(pairs, target, source, params);
-  const OffsetChoice choice = pickOffset(scores, params, source.centre());
-  r.timings.consensus = secondsSince(t0);
-  if (!choice.best) {
-    r.reason = "no slice pair produced an estimate";
-    consultDenseSearch(r, target, source, params);
-    return r;
-  }
-  const OffsetScore& best = *choice.best;
-  r.runner_up_support = choice.runner_up_support;
-  r.runner_up_offset = choice.runner_up_offset;
-  r.support = static_cast<int>(best.consensus.support());
-  r.height_offset = best.offset;
-  for (size_t k : best.consensus.supporters)
-    r.supporters.push_back({target.slices[k / ns].index, source.slices[k % ns].index, pairs.estimates[k].inliers});
-  std::stable_sort(r.supporters.begin(), r.supporters.end(),
-                   [](const SupportingPair& x, const SupportingPair& y) { return x.inliers > y.inliers; });
-
-  t0 = Clock::now();
-  const Refined refined = refineOffset(pairs, target, source, best.offset, best.consensus.mean, params);
-  r.timings.refinement = secondsSince(t0);
-
-  r.T_target_source = {refined.T.t.x(), refined.T.t.y(), target.z_min - source.z_min + best.offset * target.grid,
-                       wrapAngle(refined.T.yaw)};
-  if (target.leveled || source.leveled) r.T_target_source_unleveled = unleveled(r.T_target_source, target, source);
-  r.inliers = refined.inliers.size();
-  r.inlier_spread = inlierSpread(refined);
-  judge(r, params);
+  matchSlices(r, target, source, params, progress, cache);
   consultDenseSearch(r, target, source, params);
+  if (target.leveled || source.leveled) r.T_target_source_unleveled = unleveled(r.T_target_source, target, source);
   return r;
 }
 

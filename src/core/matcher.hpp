@@ -44,11 +44,14 @@ struct MatchResult {
   Eigen::Matrix4d matrix() const { return T_target_source_unleveled.value_or(T_target_source.matrix()); }
 
   /// What found T: "features" (the tomographic match) or "dense" (the dense
-  /// search of small maps, dense_search.hpp, when the features found no reliable answer).
+  /// search of small maps, dense_opinion.hpp, when the features found no reliable answer or one it overturned).
   std::string method = "features";
   /// Small maps only: the dense search's winner over its best other pose, in
   /// telling inliers (dense_search.hpp); 0 when it did not run.
   double dense_lead = 0;
+  /// The cell [m] of the occupancy that dense search searched: the map's grid,
+  /// or twice it where the search was asked again on pooled occupancy.
+  double dense_cell = 0;
   int support = 0;                                          ///< agreeing slice pairs at the winning height offset
   int runner_up_support = 0;                                ///< best support of another answer (OffsetChoice)
   int runner_up_offset = 0;                                 ///< its height offset [slices]

@@ -127,4 +127,24 @@ SliceStack makeSlices(const Points& points, double cell) {
   return stack;
 }
 
+SliceStack pooled(const SliceStack& fine) {
+  SliceStack out;
+  out.grid = fine.grid;
+  out.grid.cell = 2 * fine.grid.cell;
+  out.grid.z_min = fine.grid.z_min + 0.5 * fine.grid.cell;
+  out.grid.width = (fine.grid.width + 1) / 2;
+  out.grid.height = (fine.grid.height + 1) / 2;
+  out.stray = fine.stray;
+  out.partial = fine.partial;
+  out.cells.resize(static_cast<size_t>(fine.size() + 1) / 2);
+  const auto w = static_cast<uint32_t>(fine.grid.width), W = static_cast<uint32_t>(out.grid.width);
+  for (size_t k = 0; k < fine.cells.size(); ++k)
+    for (uint32_t idx : fine.cells[k]) out.cells[k / 2].push_back(idx / w / 2 * W + idx % w / 2);
+  for (auto& c : out.cells) {
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+  }
+  return out;
+}
+
 }  // namespace tomomap

@@ -61,4 +61,10 @@ constexpr int kMaxImageSide = 16384;
 /// raster would exceed kMaxImageSide.
 SliceStack makeSlices(const Points& points, double cell);
 
+/// The same occupancy at twice the cell: each 2 x 2 block of cells and each
+/// two slices become one (a cell occupied where any of its eight was). Pooled
+/// slice k holds slices 2k and 2k + 1, so its centre sits half a fine slice
+/// above slice 2k's: an offset of K pooled slices is 2K fine ones.
+SliceStack pooled(const SliceStack& fine);
+
 }  // namespace tomomap

@@ -94,10 +94,11 @@ std::string wrongAnswer(const RoomMatch& m) {
 // Small rooms (under 32 slices at g 0.1, partial overlap): the features alone
 // refused all ten (docs/results.md, "Small rooms"); the dense search answers
 // them. At g 0.1 they must succeed as often as the tall worlds above; at
-// 0.05, where slices are noisier against the grid, fewer are answered, and
-// none may be answered wrong at either grid.
+// 0.05, where walls are noisier against the grid, fewer are answered (7 of
+// 10 before the search on pooled occupancy, 8 since), and none may be
+// answered wrong at either grid.
 TEST(SmallRooms, SucceedLikeTallMapsAtTheirGridAndAreNeverAnsweredWrong) {
-  for (const auto& [grid, needed] : {std::pair{0.1, 9}, std::pair{0.05, 5}}) {
+  for (const auto& [grid, needed] : {std::pair{0.1, 9}, std::pair{0.05, 7}}) {
     int right = 0, refused = 0, wrong = 0;
     for (uint64_t seed = 1; seed <= 10; ++seed) {
       const RoomMatch m = matchRoom(seed, "low", grid);
@@ -126,7 +127,8 @@ TEST(SmallRooms, AWeakFeatureWinnerIsCheckedDenselyHoweverFarItLeads) {
 // A high-noise room at g 0.05 (seed 14) came out of the features reliable and
 // half-turned (9 slice pairs against 5) while the dense search preferred the
 // right pose by 1.35x, short of the 1.4x it needs to answer. Refusing needs
-// less than answering: that lead is enough to refuse the features.
+// less than answering: that lead is enough to refuse the features (the search
+// on pooled occupancy now answers it, right).
 TEST(SmallRooms, ADenseSearchShortOfAnsweringStillRefusesAFeatureAnswerItContradicts) {
   const RoomMatch m = matchRoom(14, "high", 0.05);
   EXPECT_FALSE(m.answeredWrong(0.05)) << wrongAnswer(m);
@@ -162,4 +164,20 @@ TEST(SmallRooms, AClearDensePoseReplacesAFeatureAnswerItContradicts) {
   EXPECT_TRUE(m.result.reliable && m.right(0.1))
       << m.result.reason << " " << m.error.translation << " m off (" << m.result.method << ")";
   EXPECT_EQ(m.result.method, "dense");
+}
+
+// At g 0.05 a room's 5 cm of wall noise splits its walls across neighbouring
+// cells, and the dense search at the map's grid leaves more rooms refused
+// than at g 0.1 (of 200 low-noise seeds, 49 refused at 0.05 were right at
+// 0.1). Where it does, the search is asked again on the occupancy pooled to
+// 0.1 m: seed 3 at low noise and seed 10 at high noise were refused before,
+// each short of a clear pose at 0.05 m cells (docs/results.md, "Small rooms").
+TEST(SmallRooms, WhereTheGridLeavesARoomRefusedPooledOccupancyAnswersIt) {
+  for (const auto& [seed, noise] : {std::pair<uint64_t, const char*>{3, "low"}, {10, "high"}}) {
+    const RoomMatch m = matchRoom(seed, noise, 0.05);
+    EXPECT_TRUE(m.result.reliable && m.right(0.05))
+        << "seed " << seed << " " << noise << ": " << m.result.reason << " " << m.error.translation << " m off";
+    EXPECT_EQ(m.result.method, "dense") << "seed " << seed;
+    EXPECT_NEAR(m.result.dense_cell, 0.1, 1e-9) << "seed " << seed << ": not the pooled search's answer";
+  }
 }

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "core/slices.hpp"
@@ -79,3 +81,24 @@ TEST(Slices, TooFineGridFailsLoudly) {
 }
 
 TEST(Slices, EmptyMapGivesEmptyStack) { EXPECT_EQ(makeSlices({}, 0.1).size(), 0); }
+
+TEST(Slices, PoolingKeepsEveryOccupiedCellAtTwiceTheCell) {
+  const SliceStack fine = makeSlices(room(0.05), 0.05);
+  const SliceStack p = pooled(fine);
+  EXPECT_DOUBLE_EQ(p.grid.cell, 0.1);
+  EXPECT_EQ(p.size(), (fine.size() + 1) / 2);
+  EXPECT_EQ(p.grid.width, (fine.grid.width + 1) / 2);
+  EXPECT_EQ(p.grid.height, (fine.grid.height + 1) / 2);
+  // Pooled slice k sits midway between fine slices 2k and 2k + 1.
+  EXPECT_NEAR(p.grid.sliceHeight(3), 0.5 * (fine.grid.sliceHeight(6) + fine.grid.sliceHeight(7)), 1e-9);
+  for (int k = 0; k < fine.size(); ++k)
+    for (uint32_t idx : fine.cells[static_cast<size_t>(k)]) {
+      const Eigen::Vector2d c = fine.grid.cellCentre(idx);
+      const Eigen::Vector2d at = p.grid.toPixel(c.x(), c.y());  // a fine centre is a quarter cell off a pooled one
+      const auto pooled_idx = static_cast<uint32_t>(std::lround(at.y()) * p.grid.width + std::lround(at.x()));
+      const auto& cells = p.cells[static_cast<size_t>(k / 2)];
+      ASSERT_TRUE(std::binary_search(cells.begin(), cells.end(), pooled_idx)) << "slice " << k << " cell " << idx;
+    }
+  // No cell is made up: a wall slice still holds the room's outline alone.
+  EXPECT_EQ(p.cells[10].size(), 2u * static_cast<size_t>(p.grid.width + p.grid.height) - 4);
+}
