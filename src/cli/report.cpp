@@ -67,8 +67,7 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
         r.support, r.runner_up_support, r.inliers, r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z());
     if (r.dense_lead > 0)
       out << format("dense search     %s; at %.2f m cells its best pose has %.2fx the telling cells of the next\n",
-                    r.method == "dense" ? "found this answer" : "ran beside the features", r.dense_cell,
-                    r.dense_lead);
+                    r.method == "dense" ? "found this answer" : "ran beside the features", r.dense_cell, r.dense_lead);
     out << "tilt             target " << tiltText(r.target_tilt) << ", source " << tiltText(r.source_tilt) << "\n";
     out << format(
         "slices           target %d (%zu features), source %d (%zu features), %zu of %zu slice pairs matched\n",

@@ -35,8 +35,9 @@ constexpr double kCoarsestPooledCell = 0.1;
 /// What one dense search found, its poses' offsets in the map's own slices.
 struct Opinion {
   DenseSearch search;
-  double cell = 0;  ///< of the occupancy searched [m]
-  int pooling = 1;  ///< the map's slices per slice searched
+  double cell = 0;       ///< of the occupancy searched [m]
+  int pooling = 1;       ///< the map's slices per slice searched
+  ConsensusParams same;  ///< when two poses are the same, at that cell
 };
 
 /// Searches `target` and `source` (the maps' occupancy, or both pooled by
@@ -47,7 +48,7 @@ Opinion searchAt(const MapFeatures& target, const MapFeatures& source, const Sli
   DenseSearchParams dp;
   dp.threads = matchThreads(params);
   const ConsensusParams same{params.consensus_translation_cells * t.grid.cell, params.consensus_yaw};
-  Opinion o{searchDensely(t, s, same, source.centre(), dp), t.grid.cell, pooling};
+  Opinion o{searchDensely(t, s, same, source.centre(), dp), t.grid.cell, pooling, same};
   for (DensePose& p : o.search.poses) p.offset *= pooling;
   if (pooling > 1 && !o.search.poses.empty()) {
     DensePose& best = o.search.poses.front();
@@ -68,12 +69,11 @@ void decide(MatchResult& r, const Opinion& o, const MapFeatures& target, const M
   r.dense_cell = o.cell;
   const auto leadsBy = [&](double lead) { return r.dense_lead >= lead && best.support >= params.min_support; };
   const bool clear = leadsBy(kDenseLead);
-  const ConsensusParams same{params.consensus_translation_cells * o.cell, params.consensus_yaw};
   if (r.reliable) {
     const Rigid2D features{r.T_target_source.yaw, {r.T_target_source.x, r.T_target_source.y}};
     // A pooled offset is a whole number of pooled slices: up to pooling - 1 more apart.
     const bool same_pose = std::abs(best.offset - r.height_offset) <= kSmearSlices / 2 + o.pooling - 1 &&
-                           agree(features, best.transform, same, source.centre());
+                           agree(features, best.transform, o.same, source.centre());
     if (leadsBy(kDenseOpinion) && same_pose) return;  // confirmed
     if (!clear) {
       r.reliable = false;
@@ -131,12 +131,12 @@ void consultDenseSearch(MatchResult& r, const MapFeatures& target, const MapFeat
   // answer either, the reason stays the one from the map's own grid.
   MatchResult at_grid = std::move(r);
   r = from_features;
-  decide(r, searchAt(target, source, pooled(target.occupancy), pooled(source.occupancy), 2, params), target,
-         source, params);
+  decide(r, searchAt(target, source, pooled(target.occupancy), pooled(source.occupancy), 2, params), target, source,
+         params);
   if (!r.reliable) {
     if (r.dense_lead > 0)  // the pooled search ran
-      at_grid.reason += "; at " + fixed(r.dense_cell, 2) + " m cells its best pose leads by " + fixed(r.dense_lead, 2) +
-                      "x";
+      at_grid.reason +=
+          "; at " + fixed(r.dense_cell, 2) + " m cells its best pose leads by " + fixed(r.dense_lead, 2) + "x";
     r = std::move(at_grid);
   }
   r.timings.dense = seconds();
