@@ -52,6 +52,9 @@ struct MatchResult {
   /// The cell [m] of the occupancy that dense search searched: the map's grid,
   /// or twice it where the search was asked again on pooled occupancy.
   double dense_cell = 0;
+  /// The dense search's lead on occupancy pooled to twice the cell, where the
+  /// map's grid left the pair refused; 0 when it did not run.
+  double dense_pooled_lead = 0;
   int support = 0;                                          ///< agreeing slice pairs at the winning height offset
   int runner_up_support = 0;                                ///< best support of another answer (OffsetChoice)
   int runner_up_offset = 0;                                 ///< its height offset [slices]

@@ -95,10 +95,10 @@ std::string wrongAnswer(const RoomMatch& m) {
 // refused all ten (docs/results.md, "Small rooms"); the dense search answers
 // them. At g 0.1 they must succeed as often as the tall worlds above; at
 // 0.05, where walls are noisier against the grid, fewer are answered (7 of
-// 10 before the search on pooled occupancy, 8 since), and none may be
+// 10 before the searches on pooled occupancy, 9 since), and none may be
 // answered wrong at either grid.
 TEST(SmallRooms, SucceedLikeTallMapsAtTheirGridAndAreNeverAnsweredWrong) {
-  for (const auto& [grid, needed] : {std::pair{0.1, 9}, std::pair{0.05, 7}}) {
+  for (const auto& [grid, needed] : {std::pair{0.1, 9}, std::pair{0.05, 8}}) {
     int right = 0, refused = 0, wrong = 0;
     for (uint64_t seed = 1; seed <= 10; ++seed) {
       const RoomMatch m = matchRoom(seed, "low", grid);
@@ -180,4 +180,31 @@ TEST(SmallRooms, WhereTheGridLeavesARoomRefusedPooledOccupancyAnswersIt) {
     EXPECT_EQ(m.result.method, "dense") << "seed " << seed;
     EXPECT_NEAR(m.result.dense_cell, 0.1, 1e-9) << "seed " << seed << ": not the pooled search's answer";
   }
+}
+
+// Where neither search answers alone, the map's grid and pooled occupancy
+// agreeing on the best pose is an answer: seeds 93 and 127 at high noise,
+// g 0.1, led 1.26x and 1.28x at 0.1 m cells and 1.26x and 1.21x at 0.2 m,
+// for the right pose, and were refused before. Seed 11 at low noise has both
+// searches on the same wrong pose, at 1.19x and 1.03x: still refused.
+TEST(SmallRooms, TwoSearchesShortOfAnsweringAnswerWhereTheyAgree) {
+  for (const uint64_t seed : {93, 127}) {
+    const RoomMatch m = matchRoom(seed, "high", 0.1);
+    EXPECT_TRUE(m.result.reliable && m.right(0.1))
+        << "seed " << seed << ": " << m.result.reason << " " << m.error.translation << " m off";
+    EXPECT_EQ(m.result.method, "dense") << "seed " << seed;
+    EXPECT_LT(m.result.dense_lead, 1.4) << "seed " << seed << ": the grid's search answered alone";
+    EXPECT_GT(m.result.dense_pooled_lead, 1.1) << "seed " << seed;
+  }
+  const RoomMatch m = matchRoom(11, "low", 0.1);
+  EXPECT_FALSE(m.result.reliable) << wrongAnswer(m);
+}
+
+// A search on pooled occupancy does not confirm a feature answer: on a
+// held-out room (seed 203, high noise, g 0.05) the features answered 0.27 m
+// off in height, within the 5-slice smear a confirmation allows, and the
+// pooled search confirmed it (1.28x) into a reliable answer 0.29 m off.
+TEST(SmallRooms, APooledSearchDoesNotConfirmAFeatureAnswer) {
+  const RoomMatch m = matchRoom(203, "high", 0.05);
+  EXPECT_FALSE(m.answeredWrong(0.05)) << wrongAnswer(m);
 }
