@@ -98,8 +98,8 @@ void answer(MatchResult& r, const Opinion& o, const MapFeatures& target, const M
   r.reason.clear();
   r.dense_lead = o.lead();
   r.dense_cell = o.cell;
-  r.T_target_source = {best.transform.t.x(), best.transform.t.y(),
-                       target.z_min - source.z_min + best.offset * target.grid, wrapAngle(best.transform.yaw)};
+  r.T_target_source = {best.transform.t.x(), best.transform.t.y(), heightShift(target, source, best.offset),
+                       wrapAngle(best.transform.yaw)};
   r.height_offset = best.offset;
   r.support = best.support;
   r.runner_up_support = d.poses.size() > 1 ? d.poses[1].support : 0;
@@ -146,6 +146,27 @@ void decide(MatchResult& r, const Opinion& o, const MapFeatures& target, const M
   answer(r, o, target, source);
 }
 
+/// consultDenseSearch's work on a match it does not skip.
+void settle(MatchResult& r, const MapFeatures& target, const MapFeatures& source, const MatchParams& params) {
+  const Opinion at_grid = searchAt(target, source, target.occupancy, source.occupancy, 1, params);
+  decide(r, at_grid, target, source, params);
+  if (r.reliable || !at_grid.found() || 2 * target.grid > kCoarsestPooledCell + 1e-9) return;
+  // The pooled search answers with a clear pose, or with the grid's where the
+  // two agree; it does not confirm the features' answer: on a held-out room
+  // (seed 203, high noise, g 0.05) it confirmed one 0.27 m off in height,
+  // within the smear a confirmation allows.
+  const Opinion at_pooled = searchAt(target, source, pooled(target.occupancy), pooled(source.occupancy), 2, params);
+  if (!at_pooled.found()) return;
+  r.dense_pooled_lead = at_pooled.lead();
+  if (at_pooled.leadsBy(kDenseLead, params))
+    answer(r, at_pooled, target, source);
+  else if (corroborate(at_grid, at_pooled, source, params))
+    answer(r, at_grid, target, source);
+  else
+    r.reason +=
+        "; at " + fixed(at_pooled.cell, 2) + " m cells its best pose leads by " + fixed(r.dense_pooled_lead, 2) + "x";
+}
+
 }  // namespace
 
 void consultDenseSearch(MatchResult& r, const MapFeatures& target, const MapFeatures& source,
@@ -156,31 +177,8 @@ void consultDenseSearch(MatchResult& r, const MapFeatures& target, const MapFeat
   // overturned, the widest lead was 15 to 5.
   if (r.reliable && !weakWinner(r.support - r.runner_up_support, params)) return;
   const auto t0 = std::chrono::steady_clock::now();
-  const auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-  const Opinion at_grid = searchAt(target, source, target.occupancy, source.occupancy, 1, params);
-  decide(r, at_grid, target, source, params);
-  if (r.reliable || !at_grid.found() || 2 * target.grid > kCoarsestPooledCell + 1e-9) {
-    r.timings.dense = seconds();
-    return;
-  }
-  // The pooled search answers with a clear pose, or with the grid's where the
-  // two agree; it does not confirm the features' answer: on a held-out room
-  // (seed 203, high noise, g 0.05) it confirmed one 0.27 m off in height,
-  // within the smear a confirmation allows.
-  const Opinion at_pooled = searchAt(target, source, pooled(target.occupancy), pooled(source.occupancy), 2, params);
-  if (!at_pooled.found()) {
-    r.timings.dense = seconds();
-    return;
-  }
-  r.dense_pooled_lead = at_pooled.lead();
-  if (at_pooled.leadsBy(kDenseLead, params))
-    answer(r, at_pooled, target, source);
-  else if (corroborate(at_grid, at_pooled, source, params))
-    answer(r, at_grid, target, source);
-  else
-    r.reason +=
-        "; at " + fixed(at_pooled.cell, 2) + " m cells its best pose leads by " + fixed(r.dense_pooled_lead, 2) + "x";
-  r.timings.dense = seconds();
+  settle(r, target, source, params);
+  r.timings.dense = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace tomomap

@@ -40,6 +40,11 @@ struct MapFeatures {
   Eigen::Vector2d centre() const;  ///< mean x, y of the keypoints [m]
 };
 
+/// The z of T_target_source that lays source slice k on target slice k + `offset` [m].
+inline double heightShift(const MapFeatures& target, const MapFeatures& source, int offset) {
+  return target.sliceHeight(offset) - source.z_min;
+}
+
 /// The ORB detector for one slice image: a single level, as the images are
 /// metric and there is no scale to search over. Not thread-safe to share.
 cv::Ptr<cv::ORB> sliceDetector(const FeatureParams& params);

@@ -110,7 +110,7 @@ void matchSlices(MatchResult& r, const MapFeatures& target, const MapFeatures& s
   const Refined refined = refineOffset(pairs, target, source, best.offset, best.consensus.mean, params);
   r.timings.refinement = secondsSince(t0);
 
-  r.T_target_source = {refined.T.t.x(), refined.T.t.y(), target.z_min - source.z_min + best.offset * target.grid,
+  r.T_target_source = {refined.T.t.x(), refined.T.t.y(), heightShift(target, source, best.offset),
                        wrapAngle(refined.T.yaw)};
   r.inliers = refined.inliers.size();
   r.inlier_spread = inlierSpread(refined);

@@ -49,8 +49,8 @@ struct MatchResult {
   /// Small maps only: the dense search's winner over its best other pose, in
   /// telling inliers (dense_search.hpp); 0 when it did not run.
   double dense_lead = 0;
-  /// The cell [m] of the occupancy that dense search searched: the map's grid,
-  /// or twice it where the search was asked again on pooled occupancy.
+  /// The cell [m] of the search behind dense_lead: the map's grid, or twice
+  /// it where the search on pooled occupancy answered alone; 0 when none ran.
   double dense_cell = 0;
   /// The dense search's lead on occupancy pooled to twice the cell, where the
   /// map's grid left the pair refused; 0 when it did not run.
