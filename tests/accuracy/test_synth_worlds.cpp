@@ -208,3 +208,20 @@ TEST(SmallRooms, APooledSearchDoesNotConfirmAFeatureAnswer) {
   const RoomMatch m = matchRoom(203, "high", 0.05);
   EXPECT_FALSE(m.answeredWrong(0.05)) << wrongAnswer(m);
 }
+
+// Where the features' best pose (refused: 2 slice pairs against 2 and 1), the
+// grid's and the pooled search's are one pose, it is an answer: seeds 21 and
+// 42 at high noise, g 0.1, the grid's leading 1.37x and 1.32x, the pooled
+// one's 1.05x and 1.03x, were refused before. Seed 105 at low noise, g 0.05,
+// has all three on one wrong pose, the grid's 1.03x ahead: still refused.
+TEST(SmallRooms, ThreeReadingsPickingOnePoseAnswer) {
+  for (const uint64_t seed : {21, 42}) {
+    const RoomMatch m = matchRoom(seed, "high", 0.1);
+    EXPECT_TRUE(m.result.reliable && m.right(0.1))
+        << "seed " << seed << ": " << m.result.reason << " " << m.error.translation << " m off";
+    EXPECT_EQ(m.result.method, "dense") << "seed " << seed;
+    EXPECT_LT(m.result.dense_pooled_lead, 1.1) << "seed " << seed << ": the two searches agreed without the features";
+  }
+  const RoomMatch m = matchRoom(105, "low", 0.05);
+  EXPECT_FALSE(m.result.reliable) << wrongAnswer(m);
+}
