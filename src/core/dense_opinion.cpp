@@ -37,12 +37,13 @@ constexpr double kCoarsestPooledCell = 0.2;
 constexpr double kPooledAgreement = 1.1;
 
 /// Where the features' best pose (answer or not), the grid's and the pooled
-/// search's best poses are one pose, the grid's is an answer when it leads by
-/// this. Of the room pairs neither search answered (1,420: seeds 1-350), the
-/// three agreed on a wrong pose once, the grid's leading by 1.03x (seed 105,
-/// low noise, g 0.05); on the right pose 53 times, 1.02-1.40x
-/// (docs/results.md, "Three opinions").
-constexpr double kUnanimousLead = 1.05;
+/// search's best poses are one pose, the grid's is an answer when the two
+/// searches' leads multiplied reach this. On the room pairs (seeds 1-200)
+/// neither search answered, all three agreed on a wrong pose twice, at 1.107
+/// and 1.119 (seeds 11 high and 105 low, g 0.05; each search's lead alone was
+/// as high as right ones': 1.07 and 1.08), on the right pose at 1.176 and
+/// more (docs/results.md, "Three readings").
+constexpr double kUnanimousLeads = 1.15;
 
 /// What one dense search found, its poses' offsets in the map's own slices.
 struct Opinion {
@@ -98,14 +99,17 @@ bool corroborate(const Opinion& grid, const Opinion& pooled, const MapFeatures& 
 }
 
 /// Whether the features' best pose in `r` (reliable or not), the grid's and the
-/// pooled search's best poses are all one pose, the grid's kUnanimousLead
-/// ahead: three ways of reading the maps, each picking it.
+/// pooled search's best poses are all one pose, the two searches' leads
+/// multiplied at least kUnanimousLeads: three ways of reading the maps, each
+/// picking it.
 bool unanimous(const MatchResult& r, const Opinion& grid, const Opinion& pooled, const MapFeatures& source,
                const MatchParams& params) {
   if (r.support < 1) return false;  // the features found no pose at all
   const Rigid2D features{r.T_target_source.yaw, {r.T_target_source.x, r.T_target_source.y}};
-  return grid.leadsBy(kUnanimousLead, params) && pooled.leadsBy(1.0, params) /* its best, over min_support slices */ &&
-         isBestPose(grid, features, r.height_offset, source) && isBestPose(pooled, features, r.height_offset, source);
+  // leadsBy(1.0): the best pose, over min_support slices.
+  return grid.leadsBy(1.0, params) && pooled.leadsBy(1.0, params) &&
+         grid.lead() * pooled.lead() >= kUnanimousLeads && isBestPose(grid, features, r.height_offset, source) &&
+         isBestPose(pooled, features, r.height_offset, source);
 }
 
 /// `r` answered by the opinion's best pose (`method` "dense").
