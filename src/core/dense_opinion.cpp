@@ -144,15 +144,7 @@ void decide(MatchResult& r, const Opinion& o, const MapFeatures& target, const M
   if (r.reliable) {
     const Rigid2D features{r.T_target_source.yaw, {r.T_target_source.x, r.T_target_source.y}};
     const bool same_pose = isBestPose(o, features, r.height_offset, source);
-    if (o.leadsBy(kDenseOpinion, params) && same_pose) {
-      // Confirmed, at the dense search's height: the features' offset is the
-      // centre of a smear of offsets (height_offsets.hpp), the dense search
-      // scores each. Of 7 room answers confirmed at g 0.05 and 0.1, the
-      // features' height was 0.06-0.21 m off, the dense one 0.01-0.04 m.
-      r.height_offset = best.offset;
-      r.T_target_source.z = heightShift(target, source, best.offset);
-      return;
-    }
+    if (o.leadsBy(kDenseOpinion, params) && same_pose) return;  // confirmed
     if (!clear) {
       r.reliable = false;
       if (!o.leadsBy(kDenseOpinion, params))

@@ -228,14 +228,3 @@ TEST(SmallRooms, ThreeReadingsPickingOnePoseAnswer) {
     EXPECT_FALSE(m.answeredWrong(0.05)) << "seed " << seed << " " << noise << ": " << wrongAnswer(m);
   }
 }
-
-// A feature answer the dense search confirms takes the dense search's height:
-// the features' is the centre of a smear of offsets. Seed 111 at high noise,
-// g 0.05, was confirmed 0.207 m off in height (0.219 m off in all against a
-// 0.25 m limit); the dense search's best pose is 0.007 m off in height.
-TEST(SmallRooms, AConfirmedFeatureAnswerTakesTheDenseSearchsHeight) {
-  const RoomMatch m = matchRoom(111, "high", 0.05);
-  ASSERT_TRUE(m.result.reliable) << m.result.reason;
-  EXPECT_EQ(m.result.method, "features") << "no longer a confirmed feature answer";
-  EXPECT_LT(m.error.translation, 0.1) << "yaw error " << m.error.yaw;
-}
