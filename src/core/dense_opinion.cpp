@@ -105,7 +105,7 @@ bool corroborate(const Opinion& grid, const Opinion& pooled, const MapFeatures& 
 bool unanimous(const MatchResult& r, const Opinion& grid, const Opinion& pooled, const MapFeatures& source,
                const MatchParams& params) {
   if (r.support < 1) return false;  // the features found no pose at all
-  const Rigid2D features{r.T_target_source.yaw, {r.T_target_source.x, r.T_target_source.y}};
+  const Rigid2D features = planar(r.T_target_source);
   // leadsBy(1.0): the best pose, over min_support slices.
   return grid.leadsBy(1.0, params) && pooled.leadsBy(1.0, params) &&
          grid.lead() * pooled.lead() >= kUnanimousLeads && isBestPose(grid, features, r.height_offset, source) &&
@@ -142,7 +142,7 @@ void decide(MatchResult& r, const Opinion& o, const MapFeatures& target, const M
   r.dense_cell = o.cell;
   const bool clear = o.leadsBy(kDenseLead, params);
   if (r.reliable) {
-    const Rigid2D features{r.T_target_source.yaw, {r.T_target_source.x, r.T_target_source.y}};
+    const Rigid2D features = planar(r.T_target_source);
     const bool same_pose = isBestPose(o, features, r.height_offset, source);
     if (o.leadsBy(kDenseOpinion, params) && same_pose) return;  // confirmed
     if (!clear) {

@@ -19,6 +19,9 @@ struct Rigid2D {
   Rigid2D inverse() const { return {-yaw, -Rigid2D{-yaw, Eigen::Vector2d::Zero()}.apply(t)}; }
 };
 
+/// The horizontal part of a 4-DoF pose: its x, y and yaw.
+inline Rigid2D planar(const Pose4& T) { return {T.yaw, {T.x, T.y}}; }
+
 struct Correspondences {
   std::vector<Eigen::Vector2d> source, target;  ///< matched positions [m], same length
   size_t size() const { return source.size(); }

@@ -47,8 +47,8 @@ cv::Mat drawOverlay(const SliceStack& target, const SliceStack& source, const Po
                     const std::vector<std::string>& caption) {
   std::vector<Eigen::Vector2d> t_xy = verticalStructure(target);
   std::vector<Eigen::Vector2d> s_xy = verticalStructure(source);
-  const Rigid2D planar{T.yaw, {T.x, T.y}};
-  for (auto& p : s_xy) p = planar.apply(p);
+  const Rigid2D onto_target = planar(T);
+  for (auto& p : s_xy) p = onto_target.apply(p);
 
   Eigen::Vector2d lo(INFINITY, INFINITY), hi(-INFINITY, -INFINITY);
   for (const auto* set : {&t_xy, &s_xy})
@@ -120,7 +120,7 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
   std::vector<cv::Mat> rows;
   const SliceGrid& tg = target.occupancy.grid;
   const SliceGrid& sg = source.occupancy.grid;
-  const Rigid2D T{r.T_target_source.yaw, {r.T_target_source.x, r.T_target_source.y}};
+  const Rigid2D T = planar(r.T_target_source);
   const int pad = 8;
   int drawn_pairs = 0;
   for (const auto& pair : r.supporters) {

@@ -42,7 +42,7 @@ TEST(DenseSearch, FindsARoomTurnedAndShiftedAndLeadsTheTurnsThatFitItsWalls) {
   const DensePose& best = d.poses.front();
   // p_target = moved * p_source, so T = moved; z from the slice offset.
   const Eigen::Vector2d centre(s.grid.x_min + 0.5 * s.grid.width * kGrid, s.grid.y_min + 0.5 * s.grid.height * kGrid);
-  const Eigen::Vector2d expected = Rigid2D{moved.yaw, {moved.x, moved.y}}.apply(centre);
+  const Eigen::Vector2d expected = planar(moved).apply(centre);
   EXPECT_LT((best.transform.apply(centre) - expected).norm(), 2 * kGrid);
   EXPECT_LT(std::abs(wrapAngle(best.transform.yaw - moved.yaw)), radians(2));
   EXPECT_NEAR(t.grid.z_min - s.grid.z_min + best.offset * kGrid, moved.z, kGrid);
