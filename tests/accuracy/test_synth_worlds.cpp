@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <sstream>
+#include <string>
 
 #include "core/matcher.hpp"
 #include "synth/synth.hpp"
@@ -91,6 +92,14 @@ std::string wrongAnswer(const RoomMatch& m) {
   return out.str();
 }
 
+/// Expects `m` answered right at `grid` by `method` ("features" or "dense");
+/// `what` names the pair in the messages.
+void expectAnsweredRightBy(const RoomMatch& m, double grid, const std::string& method, const std::string& what) {
+  EXPECT_TRUE(m.result.reliable && m.right(grid))
+      << what << ": " << m.result.reason << " " << m.error.translation << " m off (" << m.result.method << ")";
+  EXPECT_EQ(m.result.method, method) << what;
+}
+
 // Small rooms (under 32 slices at g 0.1, partial overlap): the features alone
 // refused all ten (docs/results.md, "Small rooms"); the dense search answers
 // them. At g 0.1 they must succeed as often as the tall worlds above; at
@@ -149,9 +158,7 @@ TEST(SmallRooms, AFeatureAnswerTheDenseSearchDoesNotConfirmIsRefused) {
     EXPECT_FALSE(m.answeredWrong(0.05)) << "seed " << seed << " " << wrongAnswer(m);
   }
   const RoomMatch confirmed = matchRoom(122, "high", 0.05);
-  EXPECT_TRUE(confirmed.result.reliable && confirmed.right(0.05))
-      << confirmed.result.reason << " " << confirmed.error.translation << " m off";
-  EXPECT_EQ(confirmed.result.method, "features");
+  expectAnsweredRightBy(confirmed, 0.05, "features", "seed 122");
 }
 
 // A clear dense pose (1.4x ahead, what it needs to answer alone) that
@@ -161,9 +168,7 @@ TEST(SmallRooms, AFeatureAnswerTheDenseSearchDoesNotConfirmIsRefused) {
 // before), the dense search 1.94x for the right pose.
 TEST(SmallRooms, AClearDensePoseReplacesAFeatureAnswerItContradicts) {
   const RoomMatch m = matchRoom(150, "high", 0.1);
-  EXPECT_TRUE(m.result.reliable && m.right(0.1))
-      << m.result.reason << " " << m.error.translation << " m off (" << m.result.method << ")";
-  EXPECT_EQ(m.result.method, "dense");
+  expectAnsweredRightBy(m, 0.1, "dense", "seed 150");
 }
 
 // At g 0.05 a room's 5 cm of wall noise splits its walls across neighbouring
@@ -175,9 +180,7 @@ TEST(SmallRooms, AClearDensePoseReplacesAFeatureAnswerItContradicts) {
 TEST(SmallRooms, WhereTheGridLeavesARoomRefusedPooledOccupancyAnswersIt) {
   for (const auto& [seed, noise] : {std::pair<uint64_t, const char*>{3, "low"}, {10, "high"}}) {
     const RoomMatch m = matchRoom(seed, noise, 0.05);
-    EXPECT_TRUE(m.result.reliable && m.right(0.05))
-        << "seed " << seed << " " << noise << ": " << m.result.reason << " " << m.error.translation << " m off";
-    EXPECT_EQ(m.result.method, "dense") << "seed " << seed;
+    expectAnsweredRightBy(m, 0.05, "dense", "seed " + std::to_string(seed) + " " + noise);
     EXPECT_NEAR(m.result.dense_cell, 0.1, 1e-9) << "seed " << seed << ": not the pooled search's answer";
   }
 }
@@ -190,9 +193,7 @@ TEST(SmallRooms, WhereTheGridLeavesARoomRefusedPooledOccupancyAnswersIt) {
 TEST(SmallRooms, TwoSearchesShortOfAnsweringAnswerWhereTheyAgree) {
   for (const uint64_t seed : {93, 127}) {
     const RoomMatch m = matchRoom(seed, "high", 0.1);
-    EXPECT_TRUE(m.result.reliable && m.right(0.1))
-        << "seed " << seed << ": " << m.result.reason << " " << m.error.translation << " m off";
-    EXPECT_EQ(m.result.method, "dense") << "seed " << seed;
+    expectAnsweredRightBy(m, 0.1, "dense", "seed " + std::to_string(seed));
     EXPECT_LT(m.result.dense_lead, 1.4) << "seed " << seed << ": the grid's search answered alone";
     EXPECT_GT(m.result.dense_pooled_lead, 1.1) << "seed " << seed;
   }
@@ -218,9 +219,7 @@ TEST(SmallRooms, APooledSearchDoesNotConfirmAFeatureAnswer) {
 TEST(SmallRooms, ThreeReadingsPickingOnePoseAnswer) {
   for (const uint64_t seed : {21, 42}) {
     const RoomMatch m = matchRoom(seed, "high", 0.1);
-    EXPECT_TRUE(m.result.reliable && m.right(0.1))
-        << "seed " << seed << ": " << m.result.reason << " " << m.error.translation << " m off";
-    EXPECT_EQ(m.result.method, "dense") << "seed " << seed;
+    expectAnsweredRightBy(m, 0.1, "dense", "seed " + std::to_string(seed));
     EXPECT_LT(m.result.dense_pooled_lead, 1.1) << "seed " << seed << ": the two searches agreed without the features";
   }
   for (const auto& [seed, noise] : {std::pair<uint64_t, const char*>{105, "low"}, {11, "high"}}) {
