@@ -13,8 +13,10 @@ namespace tomomap {
 /// refused, or replaced where the dense search clearly found another pose; so
 /// is a refused one. Where the map's own grid leaves the pair refused, the
 /// search is asked again on occupancy pooled to twice the cell, and the three
-/// (features, grid, pooled) picking one pose answer too. Larger maps
-/// are not searched. `r` is matchFeatures' answer from the features, judged.
+/// (features, grid, pooled) picking one pose answer too. Whatever answers,
+/// the answer then takes the height offset where the occupancy meets best.
+/// Larger maps are not searched. `r` is matchFeatures' answer from the
+/// features, judged.
 void consultDenseSearch(MatchResult& r, const MapFeatures& target, const MapFeatures& source,
                         const MatchParams& params);
 

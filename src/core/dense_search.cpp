@@ -69,25 +69,38 @@ struct Peak {
   int yaw_step = 0, dz = 0, dx = 0, dy = 0;
 };
 
-/// How many of the source cells `T` at `offset` lands on a dilated target cell.
+/// Where `T` puts each of `cells` on the raster `grid`: its pixel's index, or
+/// -1 off the raster. The same at every height offset, so found once per pose.
+std::vector<int> landings(const std::vector<Cell>& cells, const Rigid2D& T, const SliceGrid& grid) {
+  std::vector<int> out;
+  out.reserve(cells.size());
+  for (const Cell& c : cells) {
+    const Eigen::Vector2d q = T.apply(c.p);
+    const Eigen::Vector2d f = grid.toPixel(q.x(), q.y());
+    const int u = static_cast<int>(std::lround(f.x())), v = static_cast<int>(std::lround(f.y()));
+    out.push_back(u < 0 || v < 0 || u >= grid.width || v >= grid.height ? -1 : v * grid.width + u);
+  }
+  return out;
+}
+
+/// How many of the source `cells`, landed at `landing`, fall on a dilated
+/// target cell at height `offset`.
 struct Tally {
   size_t inliers = 0, telling = 0;
   int slices = 0;  ///< source slices with at least half their cells on the target
 };
 
-Tally countInliers(const std::vector<cv::Mat>& dilated, const SliceGrid& tg, const std::vector<Cell>& source,
-                   int offset, const Rigid2D& T, int source_slices) {
+Tally countInliers(const std::vector<cv::Mat>& dilated, const std::vector<Cell>& cells, const std::vector<int>& landing,
+                   int offset, int source_slices) {
   Tally t;
   std::vector<size_t> on(static_cast<size_t>(source_slices), 0), all(static_cast<size_t>(source_slices), 0);
-  for (const Cell& c : source) {
+  for (size_t n = 0; n < cells.size(); ++n) {
+    const Cell& c = cells[n];
     const int i = c.slice + offset;
     if (i < 0 || i >= static_cast<int>(dilated.size()) || dilated[static_cast<size_t>(i)].empty()) continue;
     ++all[static_cast<size_t>(c.slice)];
-    const Eigen::Vector2d q = T.apply(c.p);
-    const Eigen::Vector2d f = tg.toPixel(q.x(), q.y());
-    const int u = static_cast<int>(std::lround(f.x())), v = static_cast<int>(std::lround(f.y()));
-    if (u < 0 || v < 0 || u >= tg.width || v >= tg.height || !dilated[static_cast<size_t>(i)].at<uint8_t>(v, u))
-      continue;
+    // Dilated images are continuous: pixel index = element index.
+    if (landing[n] < 0 || !dilated[static_cast<size_t>(i)].ptr<uint8_t>()[landing[n]]) continue;
     ++t.inliers;
     t.telling += c.telling;
     ++on[static_cast<size_t>(c.slice)];
@@ -96,7 +109,31 @@ Tally countInliers(const std::vector<cv::Mat>& dilated, const SliceGrid& tg, con
   return t;
 }
 
+/// Every slice's occupancy grown by inlier_radius_cells: a cell lands on the
+/// stack where its pixel is set.
+std::vector<cv::Mat> dilatedSlices(const SliceStack& stack, const DenseSearchParams& params) {
+  const int r = static_cast<int>(std::floor(params.inlier_radius_cells));
+  const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
+  std::vector<cv::Mat> images(static_cast<size_t>(stack.size()));
+  for (int k = 0; k < stack.size(); ++k)
+    if (!stack.cells[static_cast<size_t>(k)].empty()) cv::dilate(stack.image(k), images[static_cast<size_t>(k)], disk);
+  return images;
+}
+
 }  // namespace
+
+int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
+                          const DenseSearchParams& params) {
+  const std::vector<cv::Mat> dilated = dilatedSlices(target, params);
+  const std::vector<Cell> cells = cellsOf(source, params.wall_spread);
+  const std::vector<int> landing = landings(cells, T, target.grid);
+  int best = middle;
+  size_t most = countInliers(dilated, cells, landing, middle, source.size()).inliers;
+  for (int o = middle - reach; o <= middle + reach; ++o)
+    if (const size_t n = countInliers(dilated, cells, landing, o, source.size()).inliers; n > most)
+      best = o, most = n;
+  return best;
+}
 
 bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params) {
   return stack.size() > 0 && !stack.partial && coarsening(stack, params.coarse_side) <= kMaxCoarsening;
@@ -193,32 +230,26 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   }
 
   // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
-  const int r = static_cast<int>(std::floor(params.inlier_radius_cells));
-  const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
-  const auto dilatedSlices = [&](const SliceStack& stack) {
-    std::vector<cv::Mat> images(static_cast<size_t>(stack.size()));
-    for (int k = 0; k < stack.size(); ++k)
-      if (!stack.cells[static_cast<size_t>(k)].empty())
-        cv::dilate(stack.image(k), images[static_cast<size_t>(k)], disk);
-    return images;
-  };
-  const std::vector<cv::Mat> dilated = dilatedSlices(target), source_dilated = dilatedSlices(source);
+  const std::vector<cv::Mat> dilated = dilatedSlices(target, params), source_dilated = dilatedSlices(source, params);
   const std::vector<Cell> target_cells = cellsOf(target, params.wall_spread);
   std::vector<DensePose> refined(coarse.size());
 #pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
   for (size_t n = 0; n < coarse.size(); ++n) {
     DensePose p = coarse[n];
-    const auto tallyAt = [&](int o) { return countInliers(dilated, tg, source_cells, o, p.transform, source.size()); };
     const auto bestOffsetNear = [&](int middle, int reach) {
+      const std::vector<int> landing = landings(source_cells, p.transform, tg);
       for (int o = middle - reach; o <= middle + reach; ++o)
-        if (const Tally t = tallyAt(o); o == middle - reach || t.inliers > p.inliers)
+        if (const Tally t = countInliers(dilated, source_cells, landing, o, source.size());
+            o == middle - reach || t.inliers > p.inliers)
           p.inliers = t.inliers, p.telling_inliers = t.telling, p.support = t.slices, p.offset = o;
     };
     bestOffsetNear(p.offset, c - 1);
     p.transform = refineOnOccupancy(target, source, p.offset, p.transform).transform;
     bestOffsetNear(p.offset, 1);
     p.telling_inliers +=
-        countInliers(source_dilated, sg, target_cells, -p.offset, p.transform.inverse(), target.size()).telling;
+        countInliers(source_dilated, target_cells, landings(target_cells, p.transform.inverse(), sg), -p.offset,
+                     target.size())
+            .telling;
     refined[n] = p;
   }
   std::stable_sort(refined.begin(), refined.end(),

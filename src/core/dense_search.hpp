@@ -49,6 +49,13 @@ struct DenseSearch {
 /// Whether `stack` is small enough for searchDensely and holds every slice's cells.
 bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params = {});
 
+/// The height offset (target slice index - source slice index) within `reach`
+/// slices of `middle` at which `T` lands the most source cells within
+/// inlier_radius_cells of a target cell; `middle` where none lands more. The
+/// dense search places each of its poses so.
+int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
+                          const DenseSearchParams& params = {});
+
 /// Correlates the maps' occupancy on a coarse raster at every yaw step, shift
 /// and height offset (FFT per slice pair), then refines the best distinct
 /// coarse poses on the full grid (refineOnOccupancy) and counts their inliers.
