@@ -130,8 +130,7 @@ int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, co
   int best = middle;
   size_t most = countInliers(dilated, cells, landing, middle, source.size()).inliers;
   for (int o = middle - reach; o <= middle + reach; ++o)
-    if (const size_t n = countInliers(dilated, cells, landing, o, source.size()).inliers; n > most)
-      best = o, most = n;
+    if (const size_t n = countInliers(dilated, cells, landing, o, source.size()).inliers; n > most) best = o, most = n;
   return best;
 }
 
@@ -246,10 +245,9 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
     bestOffsetNear(p.offset, c - 1);
     p.transform = refineOnOccupancy(target, source, p.offset, p.transform).transform;
     bestOffsetNear(p.offset, 1);
-    p.telling_inliers +=
-        countInliers(source_dilated, target_cells, landings(target_cells, p.transform.inverse(), sg), -p.offset,
-                     target.size())
-            .telling;
+    // Both ways: the target's cells landed on the source.
+    const std::vector<int> back = landings(target_cells, p.transform.inverse(), sg);
+    p.telling_inliers += countInliers(source_dilated, target_cells, back, -p.offset, target.size()).telling;
     refined[n] = p;
   }
   std::stable_sort(refined.begin(), refined.end(),

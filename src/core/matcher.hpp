@@ -55,10 +55,12 @@ struct MatchResult {
   /// The dense search's lead on occupancy pooled to twice the cell, where the
   /// map's grid left the pair refused; 0 when it did not run.
   double dense_pooled_lead = 0;
-  int support = 0;                                          ///< agreeing slice pairs at the winning height offset
-  int runner_up_support = 0;                                ///< best support of another answer (OffsetChoice)
-  int runner_up_offset = 0;                                 ///< its height offset [slices]
-  int height_offset = 0;                                    ///< winning target slice index - source slice index
+  int support = 0;            ///< agreeing slice pairs at the winning height offset
+  int runner_up_support = 0;  ///< best support of another answer (OffsetChoice)
+  int runner_up_offset = 0;   ///< its height offset [slices]
+  /// Winning target slice index - source slice index (small maps: where the
+  /// occupancy meets best, dense_opinion.hpp).
+  int height_offset = 0;
   std::vector<SupportingPair> supporters;                   ///< the slice pairs behind `support`, most inliers first
   size_t inliers = 0;                                       ///< feature correspondences consistent with the result
   Eigen::Vector3d inlier_spread = Eigen::Vector3d::Zero();  ///< std. dev. of inliers in target x, y, z [m]
