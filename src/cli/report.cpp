@@ -66,7 +66,7 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
         "quality          support %d slice pairs (runner-up %d), %zu inliers, spread x %.2f y %.2f z %.2f m\n",
         r.support, r.runner_up_support, r.inliers, r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z());
     if (r.dense_lead > 0)
-      out << format("dense search     %s; at %.2f m cells its best pose has %.2fx the telling cells of the next\n",
+      out << format("dense search     %s; at %.2f m cells its best pose leads the next by %.2fx\n",
                     r.method == "dense" ? "found this answer" : "ran beside the features", r.dense_cell, r.dense_lead);
     if (r.dense_pooled_lead > 0)
       out << format("                 on occupancy pooled to twice the cell: %.2fx\n", r.dense_pooled_lead);

@@ -11,10 +11,12 @@
 namespace tomomap {
 namespace {
 
-/// The dense search's winner must have this many times the telling cells of
-/// its best other pose. Room pairs (synth -w room, seeds 1-10, every noise, g
-/// 0.1 and 0.05): wrong winners led by 1.00-1.33, right ones by 1.04-3.37;
-/// 38 of the 54 right ones lead by 1.4 or more (docs/results.md, "Small rooms").
+/// The dense search's winner must score this many times its best other
+/// pose. Room pairs (synth -w room, seeds 1-10, every noise, g 0.1 and 0.05),
+/// ranked by telling cells alone: wrong winners led by 1.00-1.33, right ones
+/// by 1.04-3.37; 38 of the 54 right ones lead by 1.4 or more (docs/results.md,
+/// "Small rooms"). With empty space read (seeds 1-100, low and high noise, g
+/// 0.1; and pooled from g 0.05), wrong winners led by at most 1.14.
 constexpr double kDenseLead = 1.4;
 /// A feature answer on a small map stands only where the dense search's best
 /// pose is this far ahead of its next (with `min_support` slices) and is the
@@ -26,6 +28,13 @@ constexpr double kDenseLead = 1.4;
 /// ahead) and 17 of the 23 right ones (1.22x and more). docs/results.md,
 /// "Small rooms".
 constexpr double kDenseOpinion = 1.2;
+/// A dense pose that lands more than this share as many telling cells in
+/// space the other map saw empty as on its occupancy does not answer or
+/// confirm: the right best poses of room pairs (seeds 1-100, low and high
+/// noise, at 0.1 m cells) landed at most 0.18, the wrong one a held-out pair
+/// answered (seed 208, high noise, g 0.1: 2.75 m off, the right pose not
+/// among the search's candidates) 0.24 (docs/results.md, "Empty space").
+constexpr double kMostContradicted = 0.2;
 /// Pooled occupancy is searched only where its cell stays this fine [m]
 /// (maps at g 0.1 and finer): room pairs were measured up to there.
 constexpr double kCoarsestPooledCell = 0.2;
@@ -36,15 +45,6 @@ constexpr double kCoarsestPooledCell = 0.2;
 /// 1.19x and 1.08x (docs/results.md, "Small rooms").
 constexpr double kPooledAgreement = 1.1;
 
-/// Where the features' best pose (answer or not), the grid's and the pooled
-/// search's best poses are one pose, the grid's is an answer when the two
-/// searches' leads multiplied reach this. On the room pairs (seeds 1-200)
-/// neither search answered, all three agreed on a wrong pose twice, at 1.107
-/// and 1.119 (seeds 11 high and 105 low, g 0.05; each search's lead alone was
-/// as high as right ones': 1.07 and 1.08), on the right pose at 1.176 and
-/// more (docs/results.md, "Three readings").
-constexpr double kUnanimousLeads = 1.15;
-
 /// What one dense search found, its poses' offsets in the map's own slices.
 struct Opinion {
   DenseSearch search;
@@ -54,14 +54,28 @@ struct Opinion {
 
   bool found() const { return search.searched && !search.poses.empty(); }
   const DensePose& best() const { return search.poses.front(); }
-  /// The best pose's telling cells over its next's (found() only).
+  /// The best pose's score over its next's (found() only); 0 where even the
+  /// best contradicts more than it finds.
   double lead() const {
-    const size_t next = search.poses.size() > 1 ? search.poses[1].telling_inliers : 0;
-    return static_cast<double>(best().telling_inliers) / static_cast<double>(std::max<size_t>(next, 1));
+    const double next = search.poses.size() > 1 ? search.poses[1].score() : 0;
+    return best().score() <= 0 ? 0 : best().score() / std::max(next, 1.0);
   }
-  /// Whether the best pose leads by `by` over at least `min_support` slices.
+  /// The best pose's telling cells in the other map's empty space, per one
+  /// landed on its occupancy (found() only).
+  double contradiction() const {
+    return static_cast<double>(best().contradicted) / static_cast<double>(std::max<size_t>(best().telling_inliers, 1));
+  }
+  /// Whether the best pose leads by `by` over at least `min_support` slices,
+  /// contradicting no more than kMostContradicted.
   bool leadsBy(double by, const MatchParams& params) const {
-    return found() && lead() >= by && best().support >= params.min_support;
+    return found() && lead() >= by && best().support >= params.min_support && contradiction() <= kMostContradicted;
+  }
+  /// What keeps the best pose from counting however far it leads, if anything.
+  std::string contradictionNote() const {
+    if (!found() || contradiction() <= kMostContradicted) return "";
+    return "; it lands " + fixed(100 * contradiction(), 0) +
+           " % as many telling cells in space the other map saw empty as on its occupancy (at most " +
+           fixed(100 * kMostContradicted, 0) + " %)";
   }
 };
 
@@ -96,20 +110,6 @@ bool isBestPose(const Opinion& o, const Rigid2D& a, int offset, const MapFeature
 bool corroborate(const Opinion& grid, const Opinion& pooled, const MapFeatures& source, const MatchParams& params) {
   return grid.leadsBy(kDenseOpinion, params) && pooled.leadsBy(kPooledAgreement, params) &&
          isBestPose(pooled, grid.best().transform, grid.best().offset, source);
-}
-
-/// Whether the features' best pose in `r` (reliable or not), the grid's and the
-/// pooled search's best poses are all one pose, the two searches' leads
-/// multiplied at least kUnanimousLeads: three ways of reading the maps, each
-/// picking it.
-bool unanimous(const MatchResult& r, const Opinion& grid, const Opinion& pooled, const MapFeatures& source,
-               const MatchParams& params) {
-  if (r.support < 1) return false;  // the features found no pose at all
-  const Rigid2D features = planar(r.T_target_source);
-  // leadsBy(1.0): the best pose, over min_support slices.
-  return grid.leadsBy(1.0, params) && pooled.leadsBy(1.0, params) &&
-         grid.lead() * pooled.lead() >= kUnanimousLeads && isBestPose(grid, features, r.height_offset, source) &&
-         isBestPose(pooled, features, r.height_offset, source);
 }
 
 /// `r` answered by the opinion's best pose (`method` "dense").
@@ -150,7 +150,8 @@ void decide(MatchResult& r, const Opinion& o, const MapFeatures& target, const M
       if (!o.leadsBy(kDenseOpinion, params))
         r.reason = "a dense search of the occupancy does not confirm the features' answer (its best pose leads by " +
                    fixed(r.dense_lead, 2) + "x with " + std::to_string(best.support) + " slices; need " +
-                   fixed(kDenseOpinion, 2) + "x and " + std::to_string(params.min_support) + ")";
+                   fixed(kDenseOpinion, 2) + "x and " + std::to_string(params.min_support) + ")" +
+                   o.contradictionNote();
       else
         r.reason = "the features and a dense search of the occupancy disagree (" + fixed(r.dense_lead, 2) +
                    "x lead for a pose " + fixed((best.transform.t - features.t).norm(), 2) + " m, " +
@@ -163,7 +164,7 @@ void decide(MatchResult& r, const Opinion& o, const MapFeatures& target, const M
     // right (0.003-0.105 m off), where the features had led by a few pairs.
   } else if (!clear) {
     r.reason += "; nor did a dense search of the occupancy find a clear pose (lead " + fixed(r.dense_lead, 2) +
-                "x, need " + fixed(kDenseLead, 2) + "x)";
+                "x, need " + fixed(kDenseLead, 2) + "x)" + o.contradictionNote();
     return;
   }
   answer(r, o, target, source);
@@ -183,11 +184,11 @@ void settle(MatchResult& r, const MapFeatures& target, const MapFeatures& source
   r.dense_pooled_lead = at_pooled.lead();
   if (at_pooled.leadsBy(kDenseLead, params))
     answer(r, at_pooled, target, source);
-  else if (corroborate(at_grid, at_pooled, source, params) || unanimous(r, at_grid, at_pooled, source, params))
+  else if (corroborate(at_grid, at_pooled, source, params))
     answer(r, at_grid, target, source);
   else
-    r.reason +=
-        "; at " + fixed(at_pooled.cell, 2) + " m cells its best pose leads by " + fixed(r.dense_pooled_lead, 2) + "x";
+    r.reason += "; at " + fixed(at_pooled.cell, 2) + " m cells its best pose leads by " +
+                fixed(r.dense_pooled_lead, 2) + "x" + at_pooled.contradictionNote();
 }
 
 /// A small map's answer at the height offset where most of the source's

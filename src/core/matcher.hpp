@@ -47,7 +47,7 @@ struct MatchResult {
   /// search of small maps, dense_opinion.hpp, when the features found no reliable answer or one it overturned).
   std::string method = "features";
   /// Small maps only: the dense search's winner over its best other pose, in
-  /// telling inliers (dense_search.hpp); 0 when it did not run.
+  /// DensePose::score (dense_search.hpp); 0 when it did not run.
   double dense_lead = 0;
   /// The cell [m] of the search behind dense_lead: the map's grid, or twice
   /// it where the search on pooled occupancy answered alone; 0 when none ran.

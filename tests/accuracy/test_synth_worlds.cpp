@@ -102,26 +102,60 @@ void expectAnsweredRightBy(const RoomMatch& m, double grid, const std::string& m
 
 // Small rooms (under 32 slices at g 0.1, partial overlap): the features alone
 // refused all ten (docs/results.md, "Small rooms"); the dense search answers
-// them. At g 0.1 they must succeed as often as the tall worlds above; at
-// 0.05, where walls are noisier against the grid, fewer are answered (7 of
-// 10 before the searches on pooled occupancy, 9 since), and none may be
-// answered wrong at either grid.
+// them. At g 0.1 they must succeed as often as the tall worlds above, at low
+// and high noise alike (10 and 10 of 10 measured; at high noise 0 of 10
+// with the features alone, 5 before the dense search read empty space); at 0.05, where
+// walls are noisier against the grid, 10 and 9 were measured. None may be
+// answered wrong.
 TEST(SmallRooms, SucceedLikeTallMapsAtTheirGridAndAreNeverAnsweredWrong) {
-  for (const auto& [grid, needed] : {std::pair{0.1, 9}, std::pair{0.05, 8}}) {
+  struct Case {
+    double grid;
+    const char* noise;
+    int needed;
+  };
+  for (const auto& [grid, noise, needed] :
+       {Case{0.1, "low", 9}, Case{0.1, "high", 9}, Case{0.05, "low", 9}, Case{0.05, "high", 8}}) {
     int right = 0, refused = 0, wrong = 0;
     for (uint64_t seed = 1; seed <= 10; ++seed) {
-      const RoomMatch m = matchRoom(seed, "low", grid);
+      const RoomMatch m = matchRoom(seed, noise, grid);
       const MatchResult& r = m.result;
       const bool ok = m.right(grid);
       (r.reliable ? (ok ? right : wrong) : refused)++;
-      std::cout << "room seed " << seed << " g " << grid << ": "
+      std::cout << "room seed " << seed << " " << noise << " g " << grid << ": "
                 << (r.reliable ? (ok ? "right" : "WRONG") + (" by " + r.method) : "no reliable match: " + r.reason)
                 << "\n";
     }
-    std::cout << "g " << grid << ": " << right << " right, " << refused << " refused, " << wrong << " wrong\n";
-    EXPECT_EQ(wrong, 0) << "at g " << grid;
-    EXPECT_GE(right, needed) << "at g " << grid;
+    std::cout << noise << " noise, g " << grid << ": " << right << " right, " << refused << " refused, " << wrong
+              << " wrong\n";
+    EXPECT_EQ(wrong, 0) << noise << " noise, g " << grid;
+    EXPECT_GE(right, needed) << noise << " noise, g " << grid;
   }
+}
+
+// A half-turned room fits a room's walls as well as the right pose, and with
+// high noise the furniture's cells landed on each other nearly as often too:
+// seeds 2, 3 and 6 at g 0.1 were refused, the search's best pose leading by
+// 1.19-1.36x in telling cells. Under the half turn each map's furniture lands
+// in the other's open floor space; counted against the pose, the right one
+// now leads by 1.66-2.81x and answers alone (docs/algorithm.md, "Empty space").
+TEST(SmallRooms, EmptySpaceTheOtherMapSawTellsARoomFromItsHalfTurn) {
+  for (const uint64_t seed : {2, 3, 6}) {
+    const RoomMatch m = matchRoom(seed, "high", 0.1);
+    expectAnsweredRightBy(m, 0.1, "dense", "seed " + std::to_string(seed));
+    EXPECT_GE(m.result.dense_lead, 1.4) << "seed " << seed;
+    EXPECT_EQ(m.result.dense_pooled_lead, 0.0) << "seed " << seed << ": not the grid's search alone";
+  }
+}
+
+// The right pose need not be among the search's candidates: on a held-out
+// room (seed 208, high noise, g 0.1) none of its 12 was, and the best, one
+// enclosure laid on a like one 2.75 m off, led its next by 1.40x once empty
+// space was read. It landed 24 % as many telling cells in space the other map
+// saw empty as on its occupancy; right best poses landed at most 18 %.
+TEST(SmallRooms, APoseThatContradictsWhatTheOtherMapSawEmptyDoesNotAnswer) {
+  const RoomMatch m = matchRoom(208, "high", 0.1);
+  EXPECT_FALSE(m.result.reliable) << wrongAnswer(m);
+  EXPECT_NE(m.result.reason.find("in space the other map saw empty"), std::string::npos) << m.result.reason;
 }
 
 // A noise-free room at g 0.05 (seed 8) came out of the features reliable and
@@ -165,7 +199,8 @@ TEST(SmallRooms, AFeatureAnswerTheDenseSearchDoesNotConfirmIsRefused) {
 // contradicts a narrow feature answer replaces it, as it replaces a refused
 // one: on the 820 room pairs it did so 11 times, each right. Seed 150 at high
 // noise, g 0.1: the features led 8 to 2 for a half-turned room (refused
-// before), the dense search 1.94x for the right pose.
+// before), the dense search 1.94x for the right pose (21x since it reads
+// empty space).
 TEST(SmallRooms, AClearDensePoseReplacesAFeatureAnswerItContradicts) {
   const RoomMatch m = matchRoom(150, "high", 0.1);
   expectAnsweredRightBy(m, 0.1, "dense", "seed 150");
@@ -186,17 +221,16 @@ TEST(SmallRooms, WhereTheGridLeavesARoomRefusedPooledOccupancyAnswersIt) {
 }
 
 // Where neither search answers alone, the map's grid and pooled occupancy
-// agreeing on the best pose is an answer: seeds 93 and 127 at high noise,
-// g 0.1, led 1.26x and 1.28x at 0.1 m cells and 1.26x and 1.21x at 0.2 m,
-// for the right pose, and were refused before. Seed 11 at low noise has both
-// searches on the same wrong pose, at 1.19x and 1.03x: still refused.
+// agreeing on the best pose is an answer: seed 23 at low noise, g 0.05, leads
+// 1.24x at 0.05 m cells and 1.37x at 0.1 m, for the right pose. Seed 11 at
+// low noise, g 0.1, has both searches on one wrong pose, at 1.11x and 1.02x:
+// refused.
 TEST(SmallRooms, TwoSearchesShortOfAnsweringAnswerWhereTheyAgree) {
-  for (const uint64_t seed : {93, 127}) {
-    const RoomMatch m = matchRoom(seed, "high", 0.1);
-    expectAnsweredRightBy(m, 0.1, "dense", "seed " + std::to_string(seed));
-    EXPECT_LT(m.result.dense_lead, 1.4) << "seed " << seed << ": the grid's search answered alone";
-    EXPECT_GT(m.result.dense_pooled_lead, 1.1) << "seed " << seed;
-  }
+  const RoomMatch agreed = matchRoom(23, "low", 0.05);
+  expectAnsweredRightBy(agreed, 0.05, "dense", "seed 23");
+  EXPECT_LT(agreed.result.dense_lead, 1.4) << "the grid's search answered alone";
+  EXPECT_GT(agreed.result.dense_pooled_lead, 1.1);
+  EXPECT_LT(agreed.result.dense_pooled_lead, 1.4) << "the pooled search answered alone";
   const RoomMatch m = matchRoom(11, "low", 0.1);
   EXPECT_FALSE(m.result.reliable) << wrongAnswer(m);
 }
@@ -208,24 +242,6 @@ TEST(SmallRooms, TwoSearchesShortOfAnsweringAnswerWhereTheyAgree) {
 TEST(SmallRooms, APooledSearchDoesNotConfirmAFeatureAnswer) {
   const RoomMatch m = matchRoom(203, "high", 0.05);
   EXPECT_FALSE(m.answeredWrong(0.05)) << wrongAnswer(m);
-}
-
-// Where the features' best pose (refused: 2 slice pairs against 2 and 1), the
-// grid's and the pooled search's are one pose, it is an answer: seeds 21 and
-// 42 at high noise, g 0.1, the grid's search leading 1.37x and 1.32x, the
-// pooled one's 1.05x and 1.03x, were refused before. Seeds 105 (low noise)
-// and 11 (high noise) at g 0.05 have all three on one wrong pose, the leads
-// multiplied 1.12 and 1.11: still refused.
-TEST(SmallRooms, ThreeReadingsPickingOnePoseAnswer) {
-  for (const uint64_t seed : {21, 42}) {
-    const RoomMatch m = matchRoom(seed, "high", 0.1);
-    expectAnsweredRightBy(m, 0.1, "dense", "seed " + std::to_string(seed));
-    EXPECT_LT(m.result.dense_pooled_lead, 1.1) << "seed " << seed << ": the two searches agreed without the features";
-  }
-  for (const auto& [seed, noise] : {std::pair<uint64_t, const char*>{105, "low"}, {11, "high"}}) {
-    const RoomMatch m = matchRoom(seed, noise, 0.05);
-    EXPECT_FALSE(m.answeredWrong(0.05)) << "seed " << seed << " " << noise << ": " << wrongAnswer(m);
-  }
 }
 
 // A small map's answer takes the height offset where most of the source's

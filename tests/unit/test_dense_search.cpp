@@ -52,6 +52,35 @@ TEST(DenseSearch, FindsARoomTurnedAndShiftedAndLeadsTheTurnsThatFitItsWalls) {
   EXPECT_GT(best.support, t.size() / 2);
 }
 
+// The room is enclosed by its floor and ceiling: a pose that lands its
+// furniture in its own open floor space contradicts what the other map saw
+// there, and the right pose contradicts nothing.
+TEST(DenseSearch, ChargesAPoseForCellsItLandsInSpaceTheOtherMapSawEmpty) {
+  const SliceStack room = stackOf(roomScan());
+  const DenseSearch d = searchDensely(room, room, kSame, Eigen::Vector2d::Zero());
+  ASSERT_GE(d.poses.size(), 2u);
+  const DensePose& best = d.poses.front();
+  EXPECT_LT(best.transform.t.norm(), kGrid);
+  EXPECT_EQ(best.offset, 0);
+  for (const DensePose& p : d.poses) {
+    std::cout << "yaw " << degrees(p.transform.yaw) << " deg, t " << p.transform.t.transpose() << ": "
+              << p.telling_inliers << " telling cells landed, " << p.contradicted << " in empty space\n";
+  }
+  EXPECT_LT(best.contradicted * 50, best.telling_inliers);
+  for (size_t k = 1; k < d.poses.size(); ++k)
+    EXPECT_GT(d.poses[k].contradicted * 10, d.poses[k].telling_inliers) << "pose " << k;
+}
+
+// Finer than 0.1 m a noisy wall's cells leave the inlier radius and would
+// read as empty: there the poses are ranked by telling cells alone.
+TEST(DenseSearch, ReadsNoEmptySpaceOnCellsFinerThanAWallsNoise) {
+  const Points scan = roomScan();
+  const SliceStack fine = makeSlices(voxelFilter(scan, 0.05), 0.05);
+  const DenseSearch d = searchDensely(fine, fine, kSame, Eigen::Vector2d::Zero());
+  ASSERT_TRUE(d.searched);
+  for (const DensePose& p : d.poses) EXPECT_EQ(p.contradicted, 0u);
+}
+
 TEST(DenseSearch, LeavesLargeAndIncompleteMapsAlone) {
   const SliceStack room = stackOf(roomScan());
   SliceStack wide = room;
