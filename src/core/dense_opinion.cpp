@@ -65,14 +65,15 @@ struct Opinion {
   double contradiction() const {
     return static_cast<double>(best().contradicted) / static_cast<double>(std::max<size_t>(best().telling_inliers, 1));
   }
-  /// Whether the best pose leads by `by` over at least `min_support` slices,
-  /// contradicting no more than kMostContradicted.
+  /// Whether the best pose contradicts no more than kMostContradicted (found() only).
+  bool consistent() const { return contradiction() <= kMostContradicted; }
+  /// Whether the best pose leads by `by` over at least `min_support` slices, consistent.
   bool leadsBy(double by, const MatchParams& params) const {
-    return found() && lead() >= by && best().support >= params.min_support && contradiction() <= kMostContradicted;
+    return found() && lead() >= by && best().support >= params.min_support && consistent();
   }
   /// What keeps the best pose from counting however far it leads, if anything.
   std::string contradictionNote() const {
-    if (!found() || contradiction() <= kMostContradicted) return "";
+    if (!found() || consistent()) return "";
     return "; it lands " + fixed(100 * contradiction(), 0) +
            " % as many telling cells in space the other map saw empty as on its occupancy (at most " +
            fixed(100 * kMostContradicted, 0) + " %)";
