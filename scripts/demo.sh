@@ -6,8 +6,12 @@
 # transforms next to the ground truth, and stops them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/build.sh >/dev/null
 build=${BUILD_DIR:-build}
+if [ ! -x "$build/daemon/tomomapd" ]; then
+  echo "== first run: installing what is missing and building tomomap and tomomapd (on a fresh 2-core"
+  echo "   machine about 5 min of apt and 3 min of compiling; later runs start in seconds)"
+fi
+TARGETS="tomomap tomomapd" BUILD_PROGRESS=1 scripts/build.sh
 out=demo-out
 rm -rf "$out"
 echo "== generating a two-floor building seen by three robots (seed 7, low noise)"

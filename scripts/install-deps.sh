@@ -33,7 +33,22 @@ if [ "$(id -u)" -ne 0 ]; then
   SUDO=sudo
 fi
 
-echo "install-deps: installing ${missing[*]}"
+# apt's own lines go to a log, shown in full if it fails; the terminal gets a
+# line per phase with the time it took.
+log=$(mktemp /tmp/tomomap-install-deps.XXXXXX.log)
+start=$SECONDS
+run() {
+  if ! "$@" >>"$log" 2>&1; then
+    cat "$log" >&2
+    echo "install-deps: '$*' failed (apt's output above, also in $log)" >&2
+    exit 1
+  fi
+}
 export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "install-deps: ${#missing[@]} of ${#PACKAGES[@]} packages missing: ${missing[*]}"
+echo "install-deps: updating the package lists"
+run $SUDO apt-get update
+echo "install-deps: downloading and installing (a fresh Debian 12 machine takes about 5 min here; apt's log: $log)"
+run $SUDO apt-get install -y --no-install-recommends "${missing[@]}"
+echo "install-deps: done in $((SECONDS - start)) s"
+rm -f "$log"

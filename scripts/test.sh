@@ -2,19 +2,27 @@
 # The whole test suite from a fresh Debian 12 machine: installs what is missing,
 # builds, and runs every test with ctest:
 #  1. a Release build: unit, CLI, accuracy, daemon and install tests (the
-#     `large` label, full-size worlds, is left out: `ctest -L large` runs it);
+#     `large` label, full-size worlds and the long equivalence checks, is left
+#     out: `ctest -L large` runs it);
 #  2. a build with AddressSanitizer and UndefinedBehaviorSanitizer: the unit
 #     and daemon tests again, where any sanitizer report fails the run.
+# Each phase says how long it took (docs/results.md, "CI time", has the figures).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
+start=$SECONDS
+phase=$SECONDS
+took() { echo "== $1 took $((SECONDS - phase)) s ($((SECONDS - start)) s so far)"; phase=$SECONDS; }
 
 scripts/build.sh
+took "release build"
 (cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j"$jobs" --timeout 1200 -LE large)
+took "release tests"
 
 echo "== sanitizer build (ASan + UBSan): unit and daemon tests"
 BUILD_DIR=build-asan TARGETS="unit_tests daemon_tests tomomapd tomomap" \
   scripts/build.sh -DTOMOMAP_SANITIZE=ON
+took "sanitizer build"
 # new_delete_type_mismatch=0: Debian's Fast DDS 2.9.1 deletes its statistics
 # reader (StatisticsReaderImpl, 64 bytes) through a base pointer of 56 bytes
 # when a participant is deleted; that is in the library, not in tomomap.
@@ -27,10 +35,11 @@ BUILD_DIR=build-asan TARGETS="unit_tests daemon_tests tomomapd tomomap" \
 # dynamic TLS blocks as roots of their own.
 export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:new_delete_type_mismatch=0:intercept_tls_get_addr=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-(cd build-asan && ctest --output-on-failure -j"$jobs" --timeout 1200 -L unit)
-# The daemon tests run secure participants: Fast DDS's own leaks there are
-# suppressed (the file says which and why).
-# Ten daemons under ASan on two cores would take most of CI's time: the
-# six-agent test runs the same code paths here, the Release run above all ten.
-(cd build-asan && LSAN_OPTIONS="suppressions=$PWD/../tests/lsan-fastdds-security.supp" \
-  ctest --output-on-failure -j"$jobs" --timeout 1200 -L daemon -E TenAgents)
+# One run for both labels: a daemon test (one fleet at a time, mostly waiting
+# on its peers) goes beside the CPU-bound unit tests. The daemon tests take
+# Fast DDS's own security leaks as suppressed (tests/CMakeLists.txt).
+# Six and ten daemons under ASan on two cores would take most of CI's time:
+# the three-agent fleet test runs the same code paths here, the Release run
+# above all of them.
+(cd build-asan && ctest --output-on-failure -j"$jobs" --timeout 1200 -L "unit|daemon" -E "SixAgents|TenAgents")
+took "sanitizer tests"

@@ -3,6 +3,7 @@
 // winning height offset and the same transform, from a fraction of the pairs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "core/matcher.hpp"
@@ -49,25 +50,68 @@ void expectSameAnswer(const MapFeatures& target, const MapFeatures& source, Matc
   EXPECT_LT(e.yaw, 0.0005) << what;
 }
 
-}  // namespace
-
-TEST(IndexedSearch, AnswersTheDemoRoomLikeTheExhaustiveSearchWhereverTheSourceIsMoved) {
-  REQUIRE_DEMO_ROOM();
-  const auto d = test::loadDemoPair();
-  const MatchParams p;
-  const MapFeatures f1 = describeMap(d.map1, p), f2 = describeMap(d.map2, p);
-  Tally tally;
-  expectSameAnswer(f1, f2, p, "pcd2 -> pcd1", tally);
-  expectSameAnswer(f2, f1, p, "pcd1 -> pcd2", tally);
-  // The moves of DemoRoom.SucceedsWhereverTheSourceIsMoved and its corners.
+/// The moves of DemoRoom.SucceedsWhereverTheSourceIsMoved: its four corners, then 24 drawn at random.
+std::vector<Pose4> demoRoomMoves() {
   std::vector<Pose4> moves{
       {50, 50, 3, kPi}, {-50, -50, -3, -kPi + 1e-6}, {50, -50, -3, kPi / 2}, {-50, 50, 3, -kPi / 2}};
   std::mt19937 rng(2024);
   std::uniform_real_distribution<double> u(-1, 1);
   for (int i = 0; i < 24; ++i) moves.push_back({50 * u(rng), 50 * u(rng), 3 * u(rng), kPi * u(rng)});
-  for (const Pose4& M : moves)
+  return moves;
+}
+
+/// Both directions of the demo-room pair, then the source moved by moves [first, last).
+void expectDemoRoomAnswersAlike(size_t first, size_t last, bool both_directions) {
+  const auto d = test::loadDemoPair();
+  const MatchParams p;
+  const MapFeatures f1 = describeMap(d.map1, p), f2 = describeMap(d.map2, p);
+  Tally tally;
+  if (both_directions) {
+    expectSameAnswer(f1, f2, p, "pcd2 -> pcd1", tally);
+    expectSameAnswer(f2, f1, p, "pcd1 -> pcd2", tally);
+  }
+  const std::vector<Pose4> moves = demoRoomMoves();
+  for (size_t i = first; i < std::min(last, moves.size()); ++i) {
+    const Pose4& M = moves[i];
     expectSameAnswer(f1, describeMap(transformPoints(d.map2, M), p), p,
                      "move " + std::to_string(M.x) + " " + std::to_string(M.y) + " " + std::to_string(M.yaw), tally);
+  }
+}
+
+/// Every world type and noise level, seeds [first, last].
+void expectGeneratedWorldsAnswerAlike(uint64_t first, uint64_t last) {
+  Tally tally;
+  for (WorldType type : {WorldType::Indoor, WorldType::Outdoor, WorldType::Room})
+    for (const char* noise : {"none", "low", "high"})
+      for (uint64_t seed = first; seed <= last; ++seed) {
+        SceneParams sp;
+        sp.type = type;
+        sp.seed = seed;
+        sp.scale = type == WorldType::Room ? 1.0 : 0.5;
+        const Scene scene = makeScene(sp);
+        const auto maps = scanScene(scene, noiseLevel(noise), seed);
+        MatchParams p;
+        p.grid = type == WorldType::Room ? 0.1 : scene.grid;
+        expectSameAnswer(describeMap(maps[0].points, p), describeMap(maps[1].points, p), p,
+                         toString(type) + " " + noise + " seed " + std::to_string(seed), tally);
+      }
+}
+
+// The default run checks the corners and the first eight random moves, and
+// seeds 1-3 of every world; the `large` label (LargeIndexedSearch) the rest.
+constexpr size_t kDemoRoomMovesInCi = 12;
+constexpr uint64_t kSeedsInCi = 3;
+
+}  // namespace
+
+TEST(IndexedSearch, AnswersTheDemoRoomLikeTheExhaustiveSearchWhereverTheSourceIsMoved) {
+  REQUIRE_DEMO_ROOM();
+  expectDemoRoomAnswersAlike(0, kDemoRoomMovesInCi, true);
+}
+
+TEST(LargeIndexedSearch, AnswersTheDemoRoomLikeTheExhaustiveSearchWhereverTheSourceIsMoved) {
+  REQUIRE_DEMO_ROOM();
+  expectDemoRoomAnswersAlike(kDemoRoomMovesInCi, demoRoomMoves().size(), false);
 }
 
 TEST(IndexedSearch, RefusesTwoIdenticalFloorsLikeTheExhaustiveSearch) {
@@ -84,20 +128,8 @@ TEST(IndexedSearch, RefusesTwoIdenticalFloorsLikeTheExhaustiveSearch) {
   expectSameAnswer(describeMap(two_floors, p), describeMap(d.map2, p), p, "two floors", tally);
 }
 
-TEST(IndexedSearch, AnswersGeneratedWorldsLikeTheExhaustiveSearch) {
-  Tally tally;
-  for (WorldType type : {WorldType::Indoor, WorldType::Outdoor, WorldType::Room})
-    for (const char* noise : {"none", "low", "high"})
-      for (uint64_t seed = 1; seed <= 10; ++seed) {
-        SceneParams sp;
-        sp.type = type;
-        sp.seed = seed;
-        sp.scale = type == WorldType::Room ? 1.0 : 0.5;
-        const Scene scene = makeScene(sp);
-        const auto maps = scanScene(scene, noiseLevel(noise), seed);
-        MatchParams p;
-        p.grid = type == WorldType::Room ? 0.1 : scene.grid;
-        expectSameAnswer(describeMap(maps[0].points, p), describeMap(maps[1].points, p), p,
-                         toString(type) + " " + noise + " seed " + std::to_string(seed), tally);
-      }
+TEST(IndexedSearch, AnswersGeneratedWorldsLikeTheExhaustiveSearch) { expectGeneratedWorldsAnswerAlike(1, kSeedsInCi); }
+
+TEST(LargeIndexedSearch, AnswersGeneratedWorldsLikeTheExhaustiveSearch) {
+  expectGeneratedWorldsAnswerAlike(kSeedsInCi + 1, 10);
 }

@@ -182,6 +182,15 @@ inline int matchesComputed(const Fleet& fleet, const std::vector<std::string>& i
   return n;
 }
 
+/// matchesComputed once it reaches `expected` (or `timeout` passes): an agent
+/// writes status.json just after transforms.json, so right after a test saw
+/// the transforms the count may still be one write behind.
+inline int matchesComputedReaching(const Fleet& fleet, const std::vector<std::string>& ids, int expected,
+                                   std::chrono::seconds timeout = std::chrono::seconds(30)) {
+  Fleet::waitFor([&] { return matchesComputed(fleet, ids) >= expected; }, timeout);
+  return matchesComputed(fleet, ids);
+}
+
 /// How long systemd waits for tomomapd to stop after SIGTERM before killing
 /// it (TimeoutStopSec in the shipped unit): the deadline a stop must meet.
 inline std::chrono::milliseconds stopTimeout() {

@@ -26,7 +26,7 @@ TEST(Daemons, TwoAgreeOnDemoRoomAndStopCleanly) {
   // Both store the same agreed result, computed once (by whoever claimed first).
   EXPECT_EQ(a["T_target_source"], b["T_target_source"]);
   EXPECT_EQ(a["computed_by"], b["computed_by"]);
-  EXPECT_EQ(matchesComputed(fleet, {"alpha", "bravo"}), 1);
+  EXPECT_EQ(matchesComputedReaching(fleet, {"alpha", "bravo"}, 1), 1);
   // The wire carried compact features, not the map.
   const auto s = fleet.readJson("bravo", "status.json");
   EXPECT_LT(s["map"]["payload_bytes"].get<double>(), 0.25 * s["map"]["raw_bytes"].get<double>()) << s.dump(2);
@@ -62,7 +62,7 @@ TEST(Daemons, ThreeAgreeOnASynthWorldWithALateJoiner) {
     EXPECT_LT(e.yaw, 10 * kPi / 180) << name;
   }
   EXPECT_TRUE(fleet.transforms("alpha").at("alpha<-bravo")["reliable"].get<bool>());
-  EXPECT_EQ(matchesComputed(fleet, ids), 3) << "each pair exactly once";
+  EXPECT_EQ(matchesComputedReaching(fleet, ids, 3), 3) << "each pair exactly once";
   stopAll(fleet, ids);
 }
 

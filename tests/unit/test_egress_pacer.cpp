@@ -27,9 +27,9 @@ TEST(EgressPacer, NoWindowHoldsMoreThanTheRateAndOneDatagram) {
   std::mt19937 rng(7);
   std::uniform_int_distribution<size_t> size(60, 9000);
   std::exponential_distribution<double> gap(500.0);  // 500 a second on average: far above the rate
-  const auto t0 = Clock::time_point{} + 1h;
-  auto now = t0;
-  std::vector<std::pair<double, size_t>> sent;  // (seconds from t0, bytes)
+  const auto start = Clock::time_point{} + 1h;
+  auto now = start;
+  std::vector<std::pair<double, size_t>> sent;  // (seconds from start, bytes)
   size_t largest = 0;
   for (int i = 0; i < 5000; ++i) {
     now += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(gap(rng)));
@@ -37,7 +37,7 @@ TEST(EgressPacer, NoWindowHoldsMoreThanTheRateAndOneDatagram) {
     const auto at = pacer.freeAt(now);
     ASSERT_GE(at, now);
     pacer.sent(bytes, at);
-    sent.emplace_back(std::chrono::duration<double>(at - t0).count(), bytes);
+    sent.emplace_back(std::chrono::duration<double>(at - start).count(), bytes);
     largest = std::max(largest, bytes);
   }
   for (const double window : {0.1, 1.0, 5.0}) {
@@ -54,11 +54,11 @@ TEST(EgressPacer, NoWindowHoldsMoreThanTheRateAndOneDatagram) {
 
 TEST(EgressPacer, AnIdleLinkSavesNoCredit) {
   EgressPacer pacer(1000);  // 1 kB/s
-  const auto t0 = Clock::time_point{} + 1h;
-  EXPECT_EQ(pacer.freeAt(t0), t0);
-  pacer.sent(100, t0);
+  const auto start = Clock::time_point{} + 1h;
+  EXPECT_EQ(pacer.freeAt(start), start);
+  pacer.sent(100, start);
   // Ten seconds idle, then a burst: still one every 100 ms.
-  const auto later = t0 + 10s;
+  const auto later = start + 10s;
   EXPECT_EQ(pacer.freeAt(later), later);
   pacer.sent(100, later);
   EXPECT_EQ(pacer.freeAt(later), later + 100ms);

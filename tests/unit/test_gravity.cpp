@@ -13,7 +13,7 @@ namespace {
 
 /// A furnished 6 x 5 x 2.8 m room: floor, ceiling, four walls and a table top,
 /// points every 3 cm with 1 cm of noise.
-Points room() {
+Points furnishedRoom() {
   std::mt19937 rng(7);
   std::normal_distribution<float> noise(0.0f, 0.01f);
   Points p;
@@ -41,7 +41,7 @@ Eigen::Quaterniond lean(double deg, const Eigen::Vector3d& axis) {
 }  // namespace
 
 TEST(Gravity, ALevelRoomReadsLevel) {
-  const Tilt t = estimateTilt(room(), 0.05);
+  const Tilt t = estimateTilt(furnishedRoom(), 0.05);
   ASSERT_TRUE(t.measured);
   EXPECT_LT(degrees(t.angle), 0.2);
   EXPECT_GT(t.floor_patches, 20u);
@@ -51,7 +51,7 @@ TEST(Gravity, ALevelRoomReadsLevel) {
 TEST(Gravity, ALeaningRoomReadsItsLeanAndLevellingUndoesIt) {
   for (const double deg : {1.0, 3.0, 10.0, 25.0}) {
     const Eigen::Quaterniond q = lean(deg, {1, 0.4, 0});
-    const Points leaning = rotatePoints(room(), q);
+    const Points leaning = rotatePoints(furnishedRoom(), q);
     const Tilt t = estimateTilt(leaning, 0.05);
     ASSERT_TRUE(t.measured) << deg;
     EXPECT_NEAR(degrees(t.angle), deg, 0.2) << deg;

@@ -4,6 +4,7 @@
 // the rest for later, and a new map version drops the old queue.
 #include <gtest/gtest.h>
 
+#include "clock_start.hpp"
 #include "map_sender.hpp"
 
 using namespace tomomap;
@@ -55,7 +56,6 @@ struct Wire {
   }
 };
 
-const Clock::time_point t0{};
 /// Requests in these tests come from a requester that has heard nothing for long.
 constexpr Clock::duration kStalled = std::chrono::seconds(60);
 

@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 
+#include "clock_start.hpp"
 #include "pair_board.hpp"
 
 using namespace tomomap;
@@ -49,8 +50,6 @@ AgreedTransform resultOf(const PairAt& at, const std::string& by, double x = 1.0
   t.computed_by = by;
   return t;
 }
-
-const Clock::time_point t0{};
 
 }  // namespace
 

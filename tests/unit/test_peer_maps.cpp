@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "clock_start.hpp"
 #include "core/matcher.hpp"
 #include "peer_maps.hpp"
 #include "synth/synth.hpp"
@@ -34,8 +35,6 @@ std::vector<wire::SliceFeatures> samplesOf(const transport::MapOffer& offer) {
   for (const auto& [k, samples] : offer.samples) all.insert(all.end(), samples.begin(), samples.end());
   return all;
 }
-
-const Clock::time_point t0{};
 
 /// Slices a request asks for (an empty list asks for every announced slice).
 size_t asked(const wire::ChunkRequest& r) {

@@ -2,14 +2,11 @@
 // once, the rest as one summary per sender per minute.
 #include <gtest/gtest.h>
 
+#include "clock_start.hpp"
 #include "rejection_log.hpp"
 
 using namespace tomomap::daemon;
 using namespace std::chrono_literals;
-
-namespace {
-const Clock::time_point t0{};
-}
 
 TEST(RejectionLog, TheFirstIsLoggedTheRestSummarisedOncePerMinute) {
   RejectionLog log;
