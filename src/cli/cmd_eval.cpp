@@ -2,6 +2,7 @@
 // its own process (so time and peak memory are that method's alone), rows
 // written as they finish, and a Markdown summary at the end.
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -31,7 +32,7 @@ namespace fs = std::filesystem;
 constexpr double kBytesPerSlice = 8;
 
 struct Row {
-  std::string pair, noise, method;
+  std::string pair, noise, family, method;
   int exit_code = -1;
   bool reliable = false, success = false;
   double grid = 0, translation_error = NAN, yaw_error = NAN, seconds = 0, peak_rss_mb = 0;
@@ -40,12 +41,12 @@ struct Row {
 };
 
 const char* kCsvHeader =
-    "pair,noise,method,exit_code,reliable,success,translation_error_m,yaw_error_rad,wall_s,peak_rss_mb,features,"
+    "pair,noise,family,method,exit_code,reliable,success,translation_error_m,yaw_error_rad,wall_s,peak_rss_mb,features,"
     "feature_payload_bytes,raw_map_bytes,note";
 
 std::string csv(const Row& r) {
   std::ostringstream o;
-  o << std::setprecision(6) << '"' << r.pair << "\"," << r.noise << ',' << r.method << ',' << r.exit_code << ','
+  o << std::setprecision(6) << '"' << r.pair << "\"," << r.noise << ",\"" << r.family << "\"," << r.method << ',' << r.exit_code << ','
     << r.reliable << ',' << r.success << ',' << r.translation_error << ',' << r.yaw_error << ',' << r.seconds << ','
     << r.peak_rss_mb << ',' << r.features << ',' << r.payload_bytes << ',' << r.raw_bytes << ",\"" << r.note << '"';
   return o.str();
@@ -62,6 +63,7 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   Row row;
   row.pair = p.name;
   row.noise = p.noise;
+  row.family = p.family;
   row.method = method;
   row.grid = p.grid;
   const std::string json = (scratch / "result.json").string();
@@ -141,6 +143,18 @@ std::string summary(const std::string& suite, const std::vector<Row>& rows) {
       o << "–";
     o << " |\n";
   }
+  // Each family (a world at a grid, a real scan, the listed pairs) as a
+  // regression matrix reads it: a refusal of a right answer counts against
+  // the method as much as a wrong answer does, so both are shown.
+  std::map<std::pair<std::string, std::string>, std::array<int, 4>> families;  // right, refused, wrong, errors
+  for (const auto& r : rows) {
+    auto& f = families[{r.method, r.family}];
+    ++f[r.success ? 0 : r.exit_code == kExitNoMatch ? 1 : r.exit_code == kExitOk ? 2 : 3];
+  }
+  o << "\n| method | family | pairs | right | refused | wrong | errors |\n|---|---|---|---|---|---|---|\n";
+  for (const auto& [key, f] : families)
+    o << "| " << key.first << " | " << key.second << " | " << f[0] + f[1] + f[2] + f[3] << " | " << f[0] << " | "
+      << f[1] << " | " << f[2] << " | " << f[3] << " |\n";
   if (times.count("tomomap") && times.count("fpfh-ransac")) {
     o << std::setprecision(1) << "\nfpfh-ransac / tomomap: median time "
       << quantile(times["fpfh-ransac"], 0.5) / quantile(times["tomomap"], 0.5) << "x, peak memory "
@@ -195,6 +209,8 @@ int runEval(const EvalOptions& o) {
   fs::create_directories(out / "worlds", ec);
   if (ec) throw InputError(o.out + ": cannot create the output folder: " + ec.message());
 
+  // A world is generated once however many blocks match it (at other grids).
+  std::map<std::string, GeneratedWorld> worlds;
   for (const auto& y : suite.synth)
     for (const auto& noise : y.noise)
       for (int64_t seed : y.seeds) {
@@ -202,14 +218,33 @@ int runEval(const EvalOptions& o) {
         sp.type = synth::parseWorldType(y.world);
         sp.seed = static_cast<uint64_t>(seed);
         sp.scale = y.scale;
-        std::string name = y.world + "-" + noise + "-" + std::to_string(seed);
-        if (y.scale != 1.0) name += "-x" + shortNumber(y.scale);
-        if (y.grid > 0) name += "-g" + shortNumber(y.grid);
-        std::cerr << "generating " << name << "\n";
-        const GeneratedWorld w = writeSynthWorld(sp, synth::noiseLevel(noise), (out / "worlds" / name).string());
-        suite.pairs.push_back(
-            {name, w.maps[0], w.maps[1], w.poses[0], w.poses[1], y.grid > 0 ? y.grid : w.grid, noise, y.methods});
+        sp.tilt = radians(y.tilt_deg);
+        std::string world = y.world + "-" + noise + "-" + std::to_string(seed);
+        std::string variant;  // what the family adds to the world type
+        if (y.scale != 1.0) variant += " x" + shortNumber(y.scale);
+        if (y.tilt_deg != 0.0) variant += " tilt" + shortNumber(y.tilt_deg);
+        for (char c : variant) world += c == ' ' ? '-' : c;
+        if (!worlds.count(world)) {
+          std::cerr << "generating " << world << "\n";
+          worlds[world] = writeSynthWorld(sp, synth::noiseLevel(noise), (out / "worlds" / world).string());
+        }
+        const GeneratedWorld& w = worlds[world];
+        const double grid = y.grid > 0 ? y.grid : w.grid;
+        const std::string name = y.grid > 0 ? world + "-g" + shortNumber(y.grid) : world;
+        suite.pairs.push_back({name, w.maps[0], w.maps[1], w.poses[0], w.poses[1], grid, noise,
+                               y.world + " g" + shortNumber(grid) + variant, y.methods});
       }
+  for (const auto& c : suite.scans)
+    for (int64_t seed : c.seeds) {
+      synth::ScanPairParams params;
+      params.seed = static_cast<uint64_t>(seed);
+      const std::string folder = c.name + "-" + std::to_string(seed) + "-g" + shortNumber(c.grid);
+      std::cerr << "cutting " << folder << " from " << c.file << "\n";
+      std::string what;
+      const GeneratedWorld w = writeScanPair(c.file, params, (out / "worlds" / folder).string(), &what);
+      suite.pairs.push_back({folder + "-" + what, w.maps[0], w.maps[1], w.poses[0], w.poses[1], c.grid, "real",
+                             c.name + " g" + shortNumber(c.grid), c.methods});
+    }
 
   std::ofstream rows_csv(out / "rows.csv");
   std::ofstream rows_json(out / "rows.jsonl");
@@ -229,6 +264,7 @@ int runEval(const EvalOptions& o) {
       rows_json << nlohmann::json{{"schema_version", kJsonSchemaVersion},
                                   {"pair", r.pair},
                                   {"noise", r.noise},
+                                  {"family", r.family},
                                   {"method", r.method},
                                   {"exit_code", r.exit_code},
                                   {"reliable", r.reliable},
@@ -246,7 +282,7 @@ int runEval(const EvalOptions& o) {
                                   {"note", r.note}}
                        .dump()
                 << std::endl;
-      std::cerr << "[" << rows.size() << "/" << total << "] " << std::left << std::setw(28) << p.name << std::setw(12)
+      std::cerr << "[" << rows.size() << "/" << total << "] " << std::left << std::setw(28) << p.name << " " << std::setw(12)
                 << m
                 << (r.success          ? "success"
                     : r.exit_code == 1 ? "no match"
@@ -269,7 +305,7 @@ int runEval(const EvalOptions& o) {
 Command addEvalCommand(CLI::App& app) {
   auto o = std::make_shared<EvalOptions>();
   CLI::App* sub = app.add_subcommand("eval", "Run every pair of a suite through tomomap and the FPFH-RANSAC baseline.");
-  sub->add_option("SUITE", o->suite, "suite file (TOML): [[pair]] tables and/or [[synth]] tables")->required();
+  sub->add_option("SUITE", o->suite, "suite file (TOML): [[pair]], [[synth]] and [[scan]] tables")->required();
   sub->add_option("-o,--out", o->out, "output directory (rows.csv, rows.jsonl, summary.md, boxplots.png, worlds/)")
       ->capture_default_str();
   sub->add_option("-m,--methods", o->methods, "override the suite's methods (tomomap, fpfh-ransac)")

@@ -69,7 +69,7 @@ Suite loadSuite(const std::string& path) {
   } catch (const toml::parse_error& e) {
     fail(path, e.source(), std::string(e.description()));
   }
-  checkKeys(path, root, {"name", "methods", "pair", "synth"}, "the suite");
+  checkKeys(path, root, {"name", "methods", "pair", "synth", "scan"}, "the suite");
   const fs::path base = fs::path(path).parent_path();
   auto resolve = [&](const std::string& p) {
     return fs::path(p).is_absolute() ? p : (base / p).lexically_normal().string();
@@ -88,7 +88,7 @@ Suite loadSuite(const std::string& path) {
     for (const auto& e : *a) {
       const toml::table* t = e.as_table();
       if (!t) fail(path, e.source(), "each [[pair]] must be a table");
-      checkKeys(path, *t, {"name", "target", "source", "gt_target", "gt_source", "grid"}, "[[pair]]");
+      checkKeys(path, *t, {"name", "target", "source", "gt_target", "gt_source", "grid", "family"}, "[[pair]]");
       SuitePair p;
       p.target = resolve(text(path, *t, "target", "[[pair]]"));
       p.source = resolve(text(path, *t, "source", "[[pair]]"));
@@ -97,6 +97,7 @@ Suite loadSuite(const std::string& path) {
       p.name = text(path, *t, "name", "[[pair]]",
                     fs::path(p.source).stem().string() + " -> " + fs::path(p.target).stem().string());
       p.grid = number(path, *t, "grid", p.grid);
+      p.family = text(path, *t, "family", "[[pair]]", "pairs");
       std::string missing;
       for (const auto* f : {&p.target, &p.source, &p.gt_target, &p.gt_source})
         if (!fs::exists(*f)) missing = *f;
@@ -106,13 +107,21 @@ Suite loadSuite(const std::string& path) {
         s.pairs.push_back(p);
     }
   }
+  // A block's methods: a subset of the suite's.
+  auto blockMethods = [&](const toml::table& t) {
+    const auto methods = list<std::string>(path, t, "methods", {});
+    for (const auto& m : methods)
+      if (std::find(s.methods.begin(), s.methods.end(), m) == s.methods.end())
+        fail(path, t.get("methods")->source(), "method '" + m + "' is not one of the suite's methods");
+    return methods;
+  };
   if (const toml::node* synth = root.get("synth")) {
     const toml::array* a = synth->as_array();
     if (!a) fail(path, synth->source(), "'synth' must be an array of tables ([[synth]])");
     for (const auto& e : *a) {
       const toml::table* t = e.as_table();
       if (!t) fail(path, e.source(), "each [[synth]] must be a table");
-      checkKeys(path, *t, {"world", "seeds", "noise", "scale", "grid", "methods"}, "[[synth]]");
+      checkKeys(path, *t, {"world", "seeds", "noise", "scale", "tilt", "grid", "methods"}, "[[synth]]");
       SuiteSynth y;
       y.world = text(path, *t, "world", "[[synth]]");
       try {
@@ -126,15 +135,32 @@ Suite loadSuite(const std::string& path) {
         if (n != "none" && n != "low" && n != "high")
           fail(path, t->get("noise")->source(), "unknown noise level '" + n + "'");
       y.scale = number(path, *t, "scale", 1.0);
+      y.tilt_deg = number(path, *t, "tilt", 0.0);
       y.grid = number(path, *t, "grid", 0.0);
-      y.methods = list<std::string>(path, *t, "methods", y.methods);
-      for (const auto& m : y.methods)
-        if (std::find(s.methods.begin(), s.methods.end(), m) == s.methods.end())
-          fail(path, t->get("methods")->source(), "method '" + m + "' is not one of the suite's methods");
+      y.methods = blockMethods(*t);
       s.synth.push_back(y);
     }
   }
-  if (s.pairs.empty() && s.synth.empty() && s.warnings.empty()) throw InputError(path + ": the suite lists no pairs");
+  if (const toml::node* scans = root.get("scan")) {
+    const toml::array* a = scans->as_array();
+    if (!a) fail(path, scans->source(), "'scan' must be an array of tables ([[scan]])");
+    for (const auto& e : *a) {
+      const toml::table* t = e.as_table();
+      if (!t) fail(path, e.source(), "each [[scan]] must be a table");
+      checkKeys(path, *t, {"file", "name", "seeds", "grid", "methods"}, "[[scan]]");
+      SuiteScan c;
+      c.file = resolve(text(path, *t, "file", "[[scan]]"));
+      c.name = text(path, *t, "name", "[[scan]]", fs::path(c.file).stem().string());
+      c.seeds = list<int64_t>(path, *t, "seeds", c.seeds);
+      c.grid = number(path, *t, "grid", c.grid);
+      c.methods = blockMethods(*t);
+      if (!fs::exists(c.file))
+        s.warnings.push_back("scan '" + c.name + "' left out: " + c.file + ": no such file");
+      else
+        s.scans.push_back(c);
+    }
+  }
+  if (s.pairs.empty() && s.synth.empty() && s.scans.empty() && s.warnings.empty()) throw InputError(path + ": the suite lists no pairs");
   return s;
 }
 

@@ -13,6 +13,7 @@ struct SuitePair {
   std::string target, source, gt_target, gt_source;  ///< paths (resolved against the suite's folder)
   double grid = MatchParams{}.grid;                  ///< [m]
   std::string noise = "real";                        ///< noise label for grouping: real data, or the synth level
+  std::string family;                                ///< what the pair stands for in the right/refused/wrong table
   std::vector<std::string> methods;                  ///< methods for this pair; empty: the suite's
 };
 
@@ -22,8 +23,18 @@ struct SuiteSynth {
   std::vector<int64_t> seeds{1};
   std::vector<std::string> noise{"low"};
   double scale = 1.0;
+  double tilt_deg = 0;               ///< the source map rolled this much (synth --tilt) [deg]
   double grid = 0;                   ///< grid size to match at [m]; 0 = the world's own
   std::vector<std::string> methods;  ///< methods for these pairs (a subset of the suite's); empty: the suite's
+};
+
+/// Pairs cut from one real scan (synth/scan_pairs.hpp), one per seed.
+struct SuiteScan {
+  std::string file;                  ///< the scan (resolved against the suite's folder)
+  std::string name;                  ///< family name; default: the file's stem
+  std::vector<int64_t> seeds{1};
+  double grid = MatchParams{}.grid;  ///< [m]
+  std::vector<std::string> methods;  ///< as for [[synth]]
 };
 
 struct Suite {
@@ -31,12 +42,14 @@ struct Suite {
   std::vector<std::string> methods{"tomomap", "fpfh-ransac"};
   std::vector<SuitePair> pairs;
   std::vector<SuiteSynth> synth;
+  std::vector<SuiteScan> scans;
   std::vector<std::string> warnings;  ///< pairs left out (missing files), with the reason
 };
 
 /// Parses a suite. Throws InputError as "FILE:LINE:COL: problem" for syntax
 /// errors, unknown keys, unknown methods or world types, and bad values. A pair
-/// whose map or pose file is missing is left out with a warning, so the rest runs.
+/// whose map or pose file (or a scan whose file) is missing is left out with a
+/// warning, so the rest runs: real data lives beside the repository, not in it.
 Suite loadSuite(const std::string& path);
 
 }  // namespace tomomap::cli

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "synth/scan_pairs.hpp"
 #include "synth/synth.hpp"
 
 namespace tomomap::cli {
@@ -18,5 +19,11 @@ struct GeneratedWorld {
 /// Scans the scene and writes map_N.pcd, map_N-gtpose.txt and scene.json into `dir`.
 GeneratedWorld writeSynthWorld(const synth::SceneParams& params, const synth::NoiseModel& noise, const std::string& dir,
                                const std::function<void(size_t, size_t)>& progress = {});
+
+/// Cuts the scan in `scan_file` into a pair (synth::makeScanPair) and writes
+/// map_0.pcd (target), map_1.pcd (source), their poses and pair.json into `dir`;
+/// `name` is set to what the pair is (synth::describe).
+GeneratedWorld writeScanPair(const std::string& scan_file, const synth::ScanPairParams& params, const std::string& dir,
+                             std::string* name = nullptr);
 
 }  // namespace tomomap::cli

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <regex>
 #include <sstream>
 
 #include "support.hpp"
@@ -59,9 +60,36 @@ TEST(Eval, MissingMapIsLeftOutAndTheRestRuns) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("pair 'gone' left out"), std::string::npos) << r.output;
   const std::string rows = slurp(dir / "out/rows.csv");
-  EXPECT_NE(rows.find("\"room\",real,tomomap,0,1,1"), std::string::npos) << rows;
+  EXPECT_NE(rows.find("\"room\",real,\"pairs\",tomomap,0,1,1"), std::string::npos) << rows;
   const std::string md = slurp(dir / "out/summary.md");
   EXPECT_NE(md.find("| tomomap | real | 1 | 1/1 |"), std::string::npos) << md;
+}
+
+// Pairs cut from a scan (here a generated room's map; the real scans beside
+// the repository are used the same way), and the table a regression matrix
+// reads: right, refused and wrong per family.
+TEST(Eval, AScanBlockCutsPairsWithGroundTruthAndCountsRightRefusedWrong) {
+  TempDir dir;
+  const auto gen = runTomomap("synth -w room -s 2 --noise low -o " + (dir / "room"));
+  ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  std::ofstream(dir / "s.toml") << "name = \"scans\"\nmethods = [\"tomomap\"]\n"
+                                << "[[scan]]\nfile = \"room/map_0.pcd\"\nname = \"room-scan\"\nseeds = [1, 2]\n"
+                                << "grid = 0.1\n"
+                                << "[[scan]]\nfile = \"nowhere/scan.pcd\"\n";
+  const auto r = runTomomap("eval " + (dir / "s.toml") + " -o " + (dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("scan 'scan' left out: "), std::string::npos) << r.output;
+  const auto pair = nlohmann::json::parse(slurp(dir / "out/worlds/room-scan-1-g0.1/pair.json"));
+  EXPECT_GE(pair["overlap"].get<double>(), 0.2) << pair.dump(2);
+  EXPECT_LE(pair["overlap"].get<double>(), 0.6) << pair.dump(2);
+  EXPECT_GE(pair["thinning"].get<int>(), 3) << "odd seeds thin one crop";
+  // Every run lands in exactly one of right, refused, wrong or errors.
+  const std::string md = slurp(dir / "out/summary.md");
+  const std::regex row(R"(\| tomomap \| room-scan g0.1 \| 2 \| ([0-9]) \| ([0-9]) \| ([0-9]) \| ([0-9]) \|)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(md, m, row)) << md;
+  EXPECT_EQ(std::stoi(m[1]) + std::stoi(m[2]) + std::stoi(m[3]) + std::stoi(m[4]), 2) << md;
+  EXPECT_EQ(std::stoi(m[4]), 0) << "no run failed to run\n" << md;
 }
 
 // The CI suite shipped with the project: both world types, three noise levels,
