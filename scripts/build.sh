@@ -34,16 +34,19 @@ if ! "${configure[@]}" >"$log" 2>&1; then
   exit 1
 fi
 echo "build: configured in $(elapsed); compiling ${TARGETS:-everything} on $(nproc) cores"
-# The build's own percentage, printed when it moves on (a line each, so that a
-# log or a pipe reads as well as a terminal).
-last=""
+# The build's own percentage, printed when it moves forward (make counts each
+# target's steps anew, so it can go back; a line each, so that a log or a pipe
+# reads as well as a terminal).
 set +e
-"${build[@]}" 2>&1 | tee -a "$log" | while IFS= read -r line; do
-  if [[ $line =~ ^\[\ *([0-9]+)%\] ]] && [ "${BASH_REMATCH[1]}" != "$last" ]; then
-    last=${BASH_REMATCH[1]}
-    printf 'build: %3d%%  %s\n' "$last" "$(elapsed)"
-  fi
-done
+"${build[@]}" 2>&1 | tee -a "$log" | {
+  last=-1
+  while IFS= read -r line; do
+    if [[ $line =~ ^\[\ *([0-9]+)%\] ]] && [ "${BASH_REMATCH[1]}" -gt "$last" ]; then
+      last=${BASH_REMATCH[1]}
+      printf 'build: %3d%%  %s\n' "$last" "$(elapsed)"
+    fi
+  done
+}
 status=${PIPESTATUS[0]}
 set -e
 if [ "$status" -ne 0 ]; then
