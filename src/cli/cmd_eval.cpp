@@ -46,9 +46,10 @@ const char* kCsvHeader =
 
 std::string csv(const Row& r) {
   std::ostringstream o;
-  o << std::setprecision(6) << '"' << r.pair << "\"," << r.noise << ",\"" << r.family << "\"," << r.method << ',' << r.exit_code << ','
-    << r.reliable << ',' << r.success << ',' << r.translation_error << ',' << r.yaw_error << ',' << r.seconds << ','
-    << r.peak_rss_mb << ',' << r.features << ',' << r.payload_bytes << ',' << r.raw_bytes << ",\"" << r.note << '"';
+  o << std::setprecision(6) << '"' << r.pair << "\"," << r.noise << ",\"" << r.family << "\"," << r.method << ','
+    << r.exit_code << ',' << r.reliable << ',' << r.success << ',' << r.translation_error << ',' << r.yaw_error << ','
+    << r.seconds << ',' << r.peak_rss_mb << ',' << r.features << ',' << r.payload_bytes << ',' << r.raw_bytes << ",\""
+    << r.note << '"';
   return o.str();
 }
 
@@ -282,8 +283,8 @@ int runEval(const EvalOptions& o) {
                                   {"note", r.note}}
                        .dump()
                 << std::endl;
-      std::cerr << "[" << rows.size() << "/" << total << "] " << std::left << std::setw(28) << p.name << " " << std::setw(12)
-                << m
+      std::cerr << "[" << rows.size() << "/" << total << "] " << std::left << std::setw(28) << p.name << " "
+                << std::setw(12) << m
                 << (r.success          ? "success"
                     : r.exit_code == 1 ? "no match"
                     : r.exit_code != 0 ? "error"

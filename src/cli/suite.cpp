@@ -59,6 +59,20 @@ std::vector<T> list(const std::string& file, const toml::table& t, const std::st
   return out;
 }
 
+/// Calls `each` with every table of the array of tables `key` ([[key]]) in `root`.
+template <typename Each>
+void forEachTable(const std::string& file, const toml::table& root, const std::string& key, Each each) {
+  const toml::node* n = root.get(key);
+  if (!n) return;
+  const toml::array* a = n->as_array();
+  if (!a) fail(file, n->source(), "'" + key + "' must be an array of tables ([[" + key + "]])");
+  for (const auto& e : *a) {
+    const toml::table* t = e.as_table();
+    if (!t) fail(file, e.source(), "each [[" + key + "]] must be a table");
+    each(*t);
+  }
+}
+
 }  // namespace
 
 Suite loadSuite(const std::string& path) {
@@ -82,31 +96,25 @@ Suite loadSuite(const std::string& path) {
     if (m != "tomomap" && m != "fpfh-ransac")
       fail(path, root.get("methods")->source(), "unknown method '" + m + "' (use tomomap or fpfh-ransac)");
 
-  if (const toml::node* pairs = root.get("pair")) {
-    const toml::array* a = pairs->as_array();
-    if (!a) fail(path, pairs->source(), "'pair' must be an array of tables ([[pair]])");
-    for (const auto& e : *a) {
-      const toml::table* t = e.as_table();
-      if (!t) fail(path, e.source(), "each [[pair]] must be a table");
-      checkKeys(path, *t, {"name", "target", "source", "gt_target", "gt_source", "grid", "family"}, "[[pair]]");
-      SuitePair p;
-      p.target = resolve(text(path, *t, "target", "[[pair]]"));
-      p.source = resolve(text(path, *t, "source", "[[pair]]"));
-      p.gt_target = resolve(text(path, *t, "gt_target", "[[pair]]"));
-      p.gt_source = resolve(text(path, *t, "gt_source", "[[pair]]"));
-      p.name = text(path, *t, "name", "[[pair]]",
-                    fs::path(p.source).stem().string() + " -> " + fs::path(p.target).stem().string());
-      p.grid = number(path, *t, "grid", p.grid);
-      p.family = text(path, *t, "family", "[[pair]]", "pairs");
-      std::string missing;
-      for (const auto* f : {&p.target, &p.source, &p.gt_target, &p.gt_source})
-        if (!fs::exists(*f)) missing = *f;
-      if (!missing.empty())
-        s.warnings.push_back("pair '" + p.name + "' left out: " + missing + ": no such file");
-      else
-        s.pairs.push_back(p);
-    }
-  }
+  forEachTable(path, root, "pair", [&](const toml::table& t) {
+    checkKeys(path, t, {"name", "target", "source", "gt_target", "gt_source", "grid", "family"}, "[[pair]]");
+    SuitePair p;
+    p.target = resolve(text(path, t, "target", "[[pair]]"));
+    p.source = resolve(text(path, t, "source", "[[pair]]"));
+    p.gt_target = resolve(text(path, t, "gt_target", "[[pair]]"));
+    p.gt_source = resolve(text(path, t, "gt_source", "[[pair]]"));
+    p.name = text(path, t, "name", "[[pair]]",
+                  fs::path(p.source).stem().string() + " -> " + fs::path(p.target).stem().string());
+    p.grid = number(path, t, "grid", p.grid);
+    p.family = text(path, t, "family", "[[pair]]", "pairs");
+    std::string missing;
+    for (const auto* f : {&p.target, &p.source, &p.gt_target, &p.gt_source})
+      if (!fs::exists(*f)) missing = *f;
+    if (!missing.empty())
+      s.warnings.push_back("pair '" + p.name + "' left out: " + missing + ": no such file");
+    else
+      s.pairs.push_back(p);
+  });
   // A block's methods: a subset of the suite's.
   auto blockMethods = [&](const toml::table& t) {
     const auto methods = list<std::string>(path, t, "methods", {});
@@ -115,52 +123,41 @@ Suite loadSuite(const std::string& path) {
         fail(path, t.get("methods")->source(), "method '" + m + "' is not one of the suite's methods");
     return methods;
   };
-  if (const toml::node* synth = root.get("synth")) {
-    const toml::array* a = synth->as_array();
-    if (!a) fail(path, synth->source(), "'synth' must be an array of tables ([[synth]])");
-    for (const auto& e : *a) {
-      const toml::table* t = e.as_table();
-      if (!t) fail(path, e.source(), "each [[synth]] must be a table");
-      checkKeys(path, *t, {"world", "seeds", "noise", "scale", "tilt", "grid", "methods"}, "[[synth]]");
-      SuiteSynth y;
-      y.world = text(path, *t, "world", "[[synth]]");
-      try {
-        synth::parseWorldType(y.world);
-      } catch (const InputError& bad) {
-        fail(path, t->get("world")->source(), bad.what());
-      }
-      y.seeds = list<int64_t>(path, *t, "seeds", y.seeds);
-      y.noise = list<std::string>(path, *t, "noise", y.noise);
-      for (const auto& n : y.noise)
-        if (n != "none" && n != "low" && n != "high")
-          fail(path, t->get("noise")->source(), "unknown noise level '" + n + "'");
-      y.scale = number(path, *t, "scale", 1.0);
-      y.tilt_deg = number(path, *t, "tilt", 0.0);
-      y.grid = number(path, *t, "grid", 0.0);
-      y.methods = blockMethods(*t);
-      s.synth.push_back(y);
+  forEachTable(path, root, "synth", [&](const toml::table& t) {
+    checkKeys(path, t, {"world", "seeds", "noise", "scale", "tilt", "grid", "methods"}, "[[synth]]");
+    SuiteSynth y;
+    y.world = text(path, t, "world", "[[synth]]");
+    try {
+      synth::parseWorldType(y.world);
+    } catch (const InputError& bad) {
+      fail(path, t.get("world")->source(), bad.what());
     }
-  }
-  if (const toml::node* scans = root.get("scan")) {
-    const toml::array* a = scans->as_array();
-    if (!a) fail(path, scans->source(), "'scan' must be an array of tables ([[scan]])");
-    for (const auto& e : *a) {
-      const toml::table* t = e.as_table();
-      if (!t) fail(path, e.source(), "each [[scan]] must be a table");
-      checkKeys(path, *t, {"file", "name", "seeds", "grid", "methods"}, "[[scan]]");
-      SuiteScan c;
-      c.file = resolve(text(path, *t, "file", "[[scan]]"));
-      c.name = text(path, *t, "name", "[[scan]]", fs::path(c.file).stem().string());
-      c.seeds = list<int64_t>(path, *t, "seeds", c.seeds);
-      c.grid = number(path, *t, "grid", c.grid);
-      c.methods = blockMethods(*t);
-      if (!fs::exists(c.file))
-        s.warnings.push_back("scan '" + c.name + "' left out: " + c.file + ": no such file");
-      else
-        s.scans.push_back(c);
-    }
-  }
-  if (s.pairs.empty() && s.synth.empty() && s.scans.empty() && s.warnings.empty()) throw InputError(path + ": the suite lists no pairs");
+    y.seeds = list<int64_t>(path, t, "seeds", y.seeds);
+    y.noise = list<std::string>(path, t, "noise", y.noise);
+    for (const auto& n : y.noise)
+      if (n != "none" && n != "low" && n != "high")
+        fail(path, t.get("noise")->source(), "unknown noise level '" + n + "'");
+    y.scale = number(path, t, "scale", 1.0);
+    y.tilt_deg = number(path, t, "tilt", 0.0);
+    y.grid = number(path, t, "grid", 0.0);
+    y.methods = blockMethods(t);
+    s.synth.push_back(y);
+  });
+  forEachTable(path, root, "scan", [&](const toml::table& t) {
+    checkKeys(path, t, {"file", "name", "seeds", "grid", "methods"}, "[[scan]]");
+    SuiteScan c;
+    c.file = resolve(text(path, t, "file", "[[scan]]"));
+    c.name = text(path, t, "name", "[[scan]]", fs::path(c.file).stem().string());
+    c.seeds = list<int64_t>(path, t, "seeds", c.seeds);
+    c.grid = number(path, t, "grid", c.grid);
+    c.methods = blockMethods(t);
+    if (!fs::exists(c.file))
+      s.warnings.push_back("scan '" + c.name + "' left out: " + c.file + ": no such file");
+    else
+      s.scans.push_back(c);
+  });
+  if (s.pairs.empty() && s.synth.empty() && s.scans.empty() && s.warnings.empty())
+    throw InputError(path + ": the suite lists no pairs");
   return s;
 }
 

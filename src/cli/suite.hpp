@@ -30,8 +30,8 @@ struct SuiteSynth {
 
 /// Pairs cut from one real scan (synth/scan_pairs.hpp), one per seed.
 struct SuiteScan {
-  std::string file;                  ///< the scan (resolved against the suite's folder)
-  std::string name;                  ///< family name; default: the file's stem
+  std::string file;  ///< the scan (resolved against the suite's folder)
+  std::string name;  ///< family name; default: the file's stem
   std::vector<int64_t> seeds{1};
   double grid = MatchParams{}.grid;  ///< [m]
   std::vector<std::string> methods;  ///< as for [[synth]]

@@ -163,7 +163,52 @@ std::vector<cv::Mat> dilatedSlices(const SliceStack& stack, const DenseSearchPar
   return images;
 }
 
+/// What a pose is judged on, built once per pair of maps: both maps' dilated
+/// occupancy, their cells and the space each saw empty.
+struct PoseJudge {
+  const SliceStack &target, &source;
+  std::vector<cv::Mat> dilated, source_dilated;
+  std::vector<Cell> source_cells, target_cells;
+  Enclosure target_encloses, source_encloses;
+  const Enclosure *in_target, *in_source;  ///< null on cells too fine to read empty space
+
+  PoseJudge(const SliceStack& t, const SliceStack& s, const DenseSearchParams& params)
+      : target(t),
+        source(s),
+        dilated(dilatedSlices(t, params)),
+        source_dilated(dilatedSlices(s, params)),
+        source_cells(cellsOf(s, params.wall_spread)),
+        target_cells(cellsOf(t, params.wall_spread)),
+        target_encloses(t),
+        source_encloses(s),
+        in_target(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &target_encloses : nullptr),
+        in_source(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &source_encloses : nullptr) {}
+
+  /// The source's cells landed on the target by p.transform at p.offset.
+  Tally forth(const DensePose& p, const std::vector<int>& landing) const {
+    return countInliers(dilated, source_cells, landing, p.offset, source.size(), in_target);
+  }
+  /// Sets p's tally from the source's cells landed on the target (at `landing`)
+  /// and adds the target's landed back on the source: both ways.
+  void judge(DensePose& p, const Tally& there) const {
+    p.inliers = there.inliers, p.telling_inliers = there.telling, p.support = there.slices;
+    p.contradicted = there.contradicted;
+    const std::vector<int> back = landings(target_cells, p.transform.inverse(), source.grid);
+    const Tally here = countInliers(source_dilated, target_cells, back, -p.offset, target.size(), in_source);
+    p.telling_inliers += here.telling;
+    p.contradicted += here.contradicted;
+  }
+};
+
 }  // namespace
+
+DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
+                   const DenseSearchParams& params) {
+  const PoseJudge judge(target, source, params);
+  DensePose p{T, offset, 0};
+  judge.judge(p, judge.forth(p, landings(judge.source_cells, T, target.grid)));
+  return p;
+}
 
 int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
                           const DenseSearchParams& params) {
@@ -272,32 +317,25 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   }
 
   // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
-  const std::vector<cv::Mat> dilated = dilatedSlices(target, params), source_dilated = dilatedSlices(source, params);
-  const std::vector<Cell> target_cells = cellsOf(target, params.wall_spread);
-  const Enclosure target_encloses(target), source_encloses(source);
-  const bool read_empty = tg.cell >= params.finest_empty_cell - 1e-9;
-  const Enclosure* in_target = read_empty ? &target_encloses : nullptr;
-  const Enclosure* in_source = read_empty ? &source_encloses : nullptr;
+  const PoseJudge judge(target, source, params);
   std::vector<DensePose> refined(coarse.size());
 #pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
   for (size_t n = 0; n < coarse.size(); ++n) {
     DensePose p = coarse[n];
+    Tally best;
     const auto bestOffsetNear = [&](int middle, int reach) {
-      const std::vector<int> landing = landings(source_cells, p.transform, tg);
-      for (int o = middle - reach; o <= middle + reach; ++o)
-        if (const Tally t = countInliers(dilated, source_cells, landing, o, source.size(), in_target);
-            o == middle - reach || t.inliers > p.inliers)
-          p.inliers = t.inliers, p.telling_inliers = t.telling, p.support = t.slices, p.offset = o,
-          p.contradicted = t.contradicted;
+      const std::vector<int> landing = landings(judge.source_cells, p.transform, tg);
+      DensePose at = p;
+      for (int o = middle - reach; o <= middle + reach; ++o) {
+        at.offset = o;
+        if (const Tally t = judge.forth(at, landing); o == middle - reach || t.inliers > best.inliers)
+          best = t, p.offset = o;
+      }
     };
     bestOffsetNear(p.offset, c - 1);
     p.transform = refineOnOccupancy(target, source, p.offset, p.transform).transform;
     bestOffsetNear(p.offset, 1);
-    // Both ways: the target's cells landed on the source.
-    const std::vector<int> back = landings(target_cells, p.transform.inverse(), sg);
-    const Tally there = countInliers(source_dilated, target_cells, back, -p.offset, target.size(), in_source);
-    p.telling_inliers += there.telling;
-    p.contradicted += there.contradicted;
+    judge.judge(p, best);
     refined[n] = p;
   }
   std::stable_sort(refined.begin(), refined.end(),

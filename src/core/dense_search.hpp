@@ -67,6 +67,12 @@ bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params = 
 int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
                           const DenseSearchParams& params = {});
 
+/// The pose (T, offset) judged as the search judges its poses (inliers, telling
+/// cells both ways, what it contradicts), without searching or refining: for a
+/// pose found otherwise, such as the features' answer.
+DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
+                   const DenseSearchParams& params = {});
+
 /// Correlates the maps' occupancy on a coarse raster at every yaw step, shift
 /// and height offset (FFT per slice pair), then refines the best distinct
 /// coarse poses on the full grid (refineOnOccupancy) and counts their inliers.

@@ -26,12 +26,12 @@ struct ScanPairParams {
 
 /// What one pair is, for its name and the record beside the maps.
 struct ScanPairInfo {
-  double overlap = 0;     ///< share of each crop's extent along the cut that the other crop covers too
-  double cut_yaw = 0;     ///< direction the scan was cut along [rad]
-  int thinning = 1;       ///< 1 in `thinning` points kept in the degraded crop (1: noise instead)
-  double noise = 0;       ///< noise added to the degraded crop [m]
+  double overlap = 0;  ///< share of each crop's extent along the cut that the other crop covers too
+  double cut_yaw = 0;  ///< direction the scan was cut along [rad]
+  int thinning = 1;    ///< 1 in `thinning` points kept in the degraded crop (1: noise instead)
+  double noise = 0;    ///< noise added to the degraded crop [m]
   bool target_degraded = false;
-  Pose4 move;             ///< applied to the source: p_source = move(p_scan)
+  Pose4 move;  ///< applied to the source: p_source = move(p_scan)
 };
 
 struct ScanPair {

@@ -92,3 +92,27 @@ TEST(DenseSearch, LeavesLargeAndIncompleteMapsAlone) {
   EXPECT_FALSE(searchDensely(room, partial, kSame, Eigen::Vector2d::Zero()).searched);
   EXPECT_FALSE(denseSearchable(SliceStack{}));
 }
+
+// A pose found otherwise (the features' answer) is judged as the search judges
+// its own: landing the search's poses again gives their very tally, and the
+// half turn of a room on itself contradicts what the room saw empty.
+TEST(DenseSearch, LandingAGivenPoseTalliesItAsTheSearchDoes) {
+  const SliceStack room = stackOf(roomScan());
+  const DenseSearch d = searchDensely(room, room, kSame, Eigen::Vector2d::Zero());
+  ASSERT_FALSE(d.poses.empty());
+  for (const DensePose& p : d.poses) {
+    const DensePose again = landPose(room, room, p.transform, p.offset);
+    EXPECT_EQ(again.inliers, p.inliers);
+    EXPECT_EQ(again.telling_inliers, p.telling_inliers);
+    EXPECT_EQ(again.contradicted, p.contradicted);
+    EXPECT_EQ(again.support, p.support);
+  }
+  const DensePose itself = landPose(room, room, Rigid2D{}, 0);
+  EXPECT_EQ(itself.contradicted, 0u);
+  const Eigen::Vector2d centre(room.grid.x_min + 0.5 * room.grid.width * kGrid,
+                               room.grid.y_min + 0.5 * room.grid.height * kGrid);
+  Rigid2D half{kPi, Eigen::Vector2d::Zero()};
+  half.t = centre - half.apply(centre);  // turned about the room's centre
+  const DensePose turned = landPose(room, room, half, 0);
+  EXPECT_GT(turned.contradicted, itself.contradicted + 100) << turned.telling_inliers << " telling";
+}
