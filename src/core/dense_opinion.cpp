@@ -51,11 +51,11 @@ double contradiction(const DensePose& p) {
   return static_cast<double>(p.contradicted) / static_cast<double>(std::max<size_t>(p.telling_inliers, 1));
 }
 
-/// Whether a pose contradicts no more than kMostContradicted over at least
-/// `min_support` slices.
-bool holds(const DensePose& p, const MatchParams& params) {
-  return contradiction(p) <= kMostContradicted && p.support >= params.min_support;
-}
+/// Whether a pose contradicts no more than kMostContradicted.
+bool consistent(const DensePose& p) { return contradiction(p) <= kMostContradicted; }
+
+/// Whether a pose is consistent over at least `min_support` slices.
+bool holds(const DensePose& p, const MatchParams& params) { return consistent(p) && p.support >= params.min_support; }
 
 /// What one dense search found, its poses' offsets in the map's own slices.
 struct Opinion {
@@ -76,11 +76,9 @@ struct Opinion {
   /// landed on its occupancy (found() only).
   double contradiction() const { return tomomap::contradiction(best()); }
   /// Whether the best pose contradicts no more than kMostContradicted (found() only).
-  bool consistent() const { return contradiction() <= kMostContradicted; }
-  /// Whether the best pose leads by `by` over at least `min_support` slices, consistent.
-  bool leadsBy(double by, const MatchParams& params) const {
-    return found() && lead() >= by && best().support >= params.min_support && consistent();
-  }
+  bool consistent() const { return tomomap::consistent(best()); }
+  /// Whether the best pose leads by `by` and holds (found() only, else false).
+  bool leadsBy(double by, const MatchParams& params) const { return found() && lead() >= by && holds(best(), params); }
   /// What keeps the best pose from counting however far it leads, if anything.
   std::string contradictionNote() const {
     if (!found() || consistent()) return "";

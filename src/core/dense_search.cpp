@@ -184,9 +184,9 @@ struct PoseJudge {
         in_target(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &target_encloses : nullptr),
         in_source(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &source_encloses : nullptr) {}
 
-  /// The source's cells landed on the target by p.transform at p.offset.
-  Tally forth(const DensePose& p, const std::vector<int>& landing) const {
-    return countInliers(dilated, source_cells, landing, p.offset, source.size(), in_target);
+  /// The source's cells, landed on the target's raster at `landing`, at height `offset`.
+  Tally forth(const std::vector<int>& landing, int offset) const {
+    return countInliers(dilated, source_cells, landing, offset, source.size(), in_target);
   }
   /// Sets p's tally from the source's cells landed on the target (at `landing`)
   /// and adds the target's landed back on the source: both ways.
@@ -206,7 +206,7 @@ DensePose landPose(const SliceStack& target, const SliceStack& source, const Rig
                    const DenseSearchParams& params) {
   const PoseJudge judge(target, source, params);
   DensePose p{T, offset, 0};
-  judge.judge(p, judge.forth(p, landings(judge.source_cells, T, target.grid)));
+  judge.judge(p, judge.forth(landings(judge.source_cells, T, target.grid), offset));
   return p;
 }
 
@@ -230,7 +230,8 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
                           const Eigen::Vector2d& pivot, const DenseSearchParams& params) {
   DenseSearch out;
   if (!denseSearchable(target, params) || !denseSearchable(source, params)) return out;
-  const std::vector<Cell> source_cells = cellsOf(source, params.wall_spread);
+  const PoseJudge judge(target, source, params);
+  const std::vector<Cell>& source_cells = judge.source_cells;
   if (source_cells.empty()) return out;
   out.searched = true;
 
@@ -317,20 +318,16 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   }
 
   // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
-  const PoseJudge judge(target, source, params);
   std::vector<DensePose> refined(coarse.size());
 #pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
   for (size_t n = 0; n < coarse.size(); ++n) {
     DensePose p = coarse[n];
     Tally best;
     const auto bestOffsetNear = [&](int middle, int reach) {
-      const std::vector<int> landing = landings(judge.source_cells, p.transform, tg);
-      DensePose at = p;
-      for (int o = middle - reach; o <= middle + reach; ++o) {
-        at.offset = o;
-        if (const Tally t = judge.forth(at, landing); o == middle - reach || t.inliers > best.inliers)
+      const std::vector<int> landing = landings(source_cells, p.transform, tg);
+      for (int o = middle - reach; o <= middle + reach; ++o)
+        if (const Tally t = judge.forth(landing, o); o == middle - reach || t.inliers > best.inliers)
           best = t, p.offset = o;
-      }
     };
     bestOffsetNear(p.offset, c - 1);
     p.transform = refineOnOccupancy(target, source, p.offset, p.transform).transform;
