@@ -27,7 +27,7 @@ void Agent::post(std::function<void()> work) {
 namespace {
 
 std::string tiltText(const MapFeatures& f) {
-  return f.tilt.measured ? "tilt " + fixed(degrees(f.tilt.angle), 1) + " deg"
+  return f.tilt.measured ? "tilt " + fixed(degrees(f.tilt.angle), 1) + " +- " + fixed(degrees(f.tilt.uncertainty), 1) + " deg"
                          : "tilt not measurable (too few flat surfaces)";
 }
 

@@ -29,7 +29,15 @@ struct Config {
   std::string file;                      ///< where it was read from
   transport::TransportConfig transport;  ///< agent id, domain, address, ports, peers, bandwidth
   std::string map;                       ///< own map file (absolute, or relative to the config file)
-  MatchParams match;                     ///< `grid` and the [match] table; the defaults are MatchParams'
+  /// `grid` and the [match] table; the defaults are MatchParams', but for
+  /// levelling: the fleet's transforms are 4-DoF between the maps' own
+  /// frames, and a levelled map's frame is not its own, so a map leaning
+  /// beyond max_tilt is not offered.
+  MatchParams match = [] {
+    MatchParams m;
+    m.level = false;
+    return m;
+  }();
   std::string output_dir;                ///< transforms.json, status.json
   LogLevel log_level = LogLevel::Info;
   double claim_timeout_s = 30;    ///< a claim without a result is void after this [s]

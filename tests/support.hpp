@@ -17,6 +17,8 @@ namespace tomomap::test {
 
 inline std::string demoRoom() { return TOMOMAP_DEMO_ROOM; }
 inline bool haveDemoRoom() { return std::filesystem::exists(demoRoom() + "/demo-pcd1.pcd"); }
+/// The real sensor scans beside demo-room (../shared/data/real-scans).
+inline std::string realScans() { return demoRoom() + "/../real-scans"; }
 
 #define REQUIRE_DEMO_ROOM()             \
   if (!::tomomap::test::haveDemoRoom()) \

@@ -37,8 +37,9 @@ MatchedFiles matchFiles(MatchFilesOptions o) {
     if (!o.quiet) std::cout << role << " " << path << " (" << map.size() << " points)\n";
     MapFeatures f = describeMap(map, params, &timings);
     if (f.leveled)
-      std::cerr << "note: " << path << ": levelled: it leaned " << fixed(degrees(f.tilt.angle), 1)
-                << " deg from gravity\n";
+      std::cerr << "note: " << path << ": levelled: it leaned " << fixed(degrees(f.tilt.angle), 1) << " +- "
+                << fixed(degrees(f.tilt.uncertainty), 1) << " deg from gravity (read off its "
+                << (f.tilt.cue == Tilt::Cue::floors ? "floors" : "walls") << ")\n";
     m.inputs[std::string(role) + "_stray_voxels"] = f.occupancy.stray;
     if (f.occupancy.stray > 0)
       std::cerr << "warning: " << path << ": left out " << f.occupancy.stray
@@ -67,10 +68,11 @@ void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
   sub.add_option("-j,--threads", o.params.threads, "worker threads (0 = all cores)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));
-  sub.add_option("--max-tilt", o.max_tilt_deg, "refuse a map tilted more than this from gravity [deg]")
+  sub.add_option("--max-tilt", o.max_tilt_deg, "level (or refuse) a map tilted more than this from gravity [deg]")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 90.0));
-  sub.add_flag("--level", o.params.level, "level a tilted map (turn its up onto z) instead of refusing it");
+  sub.add_flag("--level,!--no-level", o.params.level,
+               "level a map tilted beyond --max-tilt (turn its up onto z; on by default); --no-level refuses it");
   sub.add_flag("--exhaustive", o.params.exhaustive,
                "match every slice pair instead of the height offsets the descriptor index points to "
                "(same answers, n^2 cost; for checking)");

@@ -21,8 +21,13 @@ constexpr double kFlatness = 0.05, kNotALine = 0.2;
 /// wall's; the rest (stairs, clutter) says nothing.
 const double kClassCone = radians(30.0);
 constexpr int kRounds = 4;
-/// Fewer flat patches than this and the tilt is not measured.
+/// Fewer flat patches than this and a cue (floors, walls) says nothing.
 constexpr size_t kMinPatches = 20;
+/// Walls tell up only where they face two ways: the scatter's middle
+/// eigenvalue at least this share of its largest.
+constexpr double kTwoWays = 0.1;
+/// A patch leaning off its kind's fit more than this many times the median is not of that kind.
+constexpr double kOutlierLeans = 3.0;
 /// Estimates, each in the frame the previous ones levelled (see estimateTilt).
 constexpr int kPasses = 3;
 /// Points looked at, at most: the large surfaces show in a sample.
@@ -73,31 +78,92 @@ std::vector<Patch> flatPatches(const Points& map, size_t stride, const Eigen::Ma
   return patches;
 }
 
-/// The up direction closest to the floor patches and farthest from the wall
-/// patches, from z in a few rounds; empty if too few flat patches.
-std::optional<Eigen::Vector3d> upOf(const std::vector<Patch>& patches, size_t& floors, size_t& walls) {
+/// One cue's up direction and how tightly its patches agree on it.
+struct Cue {
+  Eigen::Vector3d up;
+  double spread = 0;  ///< rms angle of the patches' normals from what `up` makes them [rad]
+  size_t patches = 0;
+  /// The standard error of `up` [rad].
+  double error() const { return spread / std::sqrt(static_cast<double>(patches)); }
+};
+
+/// The weighted scatter sum(w n n^T) / sum(w) of patches' normals, solved.
+Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> scatter(const std::vector<Patch>& patches) {
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  double total = 0;
+  for (const auto& p : patches) {
+    m += p.weight * p.normal * p.normal.transpose();
+    total += p.weight;
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(m / total);
+  return eig;
+}
+
+/// Up from one kind of patch, fitted twice: the second time without the
+/// patches that lean off the first fit more than kOutlierLeans times the
+/// median (kerbs, car roofs, ramps and stair edges among floors; cars, trees
+/// and leaning panels among walls): on vehicle LiDAR they pulled the floors'
+/// mean 1-3 degrees off the road's plane fit. Floors and ground face up:
+/// their mean normal, the scatter's largest eigenvector. Walls face sideways:
+/// the direction their normals avoid, its smallest; walls that all face one
+/// way (a corridor) leave it free to turn about their normal: no cue then.
+std::optional<Cue> fitUp(std::vector<Patch> patches, bool floors) {
+  // How far a patch leans off the fit: the angle of its normal from up
+  // (floors) or from the horizontal (walls), as its sine or cosine.
+  const auto lean = [floors](const Patch& p, const Eigen::Vector3d& up) {
+    const double c = std::min(1.0, std::abs(p.normal.dot(up)));
+    return floors ? std::acos(c) : std::asin(c);
+  };
+  for (int fit = 0;; ++fit) {
+    if (patches.size() < kMinPatches) return std::nullopt;
+    const auto eig = scatter(patches);
+    const Eigen::Vector3d l = eig.eigenvalues();  // ascending
+    if (!floors && !(l(1) > kTwoWays * l(2))) return std::nullopt;
+    const Eigen::Vector3d up = eig.eigenvectors().col(floors ? 2 : 0).normalized();
+    const double off = floors ? 1.0 - l(2) : l(0);  // the squared sine of the normals' rms lean
+    if (fit == 1) return Cue{up, std::asin(std::min(1.0, std::sqrt(std::max(0.0, off)))), patches.size()};
+    std::vector<double> leans;
+    for (const auto& p : patches) leans.push_back(lean(p, up));
+    std::nth_element(leans.begin(), leans.begin() + static_cast<long>(leans.size() / 2), leans.end());
+    const double most = kOutlierLeans * leans[leans.size() / 2];
+    patches.erase(std::remove_if(patches.begin(), patches.end(), [&](const Patch& p) { return lean(p, up) > most; }),
+                  patches.end());
+  }
+}
+
+/// Up from the patches, sorted into floors and walls by the up found so far
+/// (from z, in a few rounds): from the floors, or from the walls where there
+/// are too few floors. Floors are the gravity cue: in real maps walls lean a
+/// degree or three each way while floors lie level, and on vehicle LiDAR the
+/// walls' fit (cars, trees, poles) read 4-6 degrees where the road's plane
+/// fit read 1.5.
+std::optional<Cue> upOf(const std::vector<Patch>& patches, Tilt& t) {
   const double floor_cos = std::cos(kClassCone), wall_cos = std::sin(kClassCone);
+  std::optional<Cue> found;
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   for (int round = 0; round < kRounds; ++round) {
-    Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
-    floors = walls = 0;
+    std::vector<Patch> floors, walls;
     for (const auto& p : patches) {
       const double c = std::abs(p.normal.dot(up));
-      if (c >= floor_cos) {
-        m += p.weight * p.normal * p.normal.transpose();
-        ++floors;
-      } else if (c <= wall_cos) {
-        m -= p.weight * p.normal * p.normal.transpose();
-        ++walls;
-      }
+      if (c >= floor_cos)
+        floors.push_back(p);
+      else if (c <= wall_cos)
+        walls.push_back(p);
     }
-    if (floors + walls < kMinPatches) return std::nullopt;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(m);
-    up = eig.eigenvectors().col(2).normalized();
-    if (up.z() < 0) up = -up;
+    t.floor_patches = floors.size();
+    t.wall_patches = walls.size();
+    t.cue = Tilt::Cue::floors;
+    found = fitUp(std::move(floors), true);
+    if (!found) {
+      t.cue = Tilt::Cue::walls;
+      found = fitUp(std::move(walls), false);
+    }
+    if (!found) return std::nullopt;
+    up = found->up.z() < 0 ? Eigen::Vector3d(-found->up) : found->up;
+    found->up = up;
   }
-  return up;
+  return found;
 }
 
 }  // namespace
@@ -114,9 +180,10 @@ Tilt estimateTilt(const Points& map, double grid) {
   const double side = std::max(kMinPatchSide, kPatchCells * grid);
   for (int pass = 0; pass < kPasses; ++pass) {
     const Eigen::Matrix3f turn = leveling.toRotationMatrix().cast<float>();  // as rotatePoints turns
-    const auto up = upOf(flatPatches(map, stride, turn, side), t.floor_patches, t.wall_patches);
-    if (!up) return t;
-    leveling = Eigen::Quaterniond::FromTwoVectors(*up, Eigen::Vector3d::UnitZ()) * leveling;
+    const auto cue = upOf(flatPatches(map, stride, turn, side), t);
+    if (!cue) return t;
+    leveling = Eigen::Quaterniond::FromTwoVectors(cue->up, Eigen::Vector3d::UnitZ()) * leveling;
+    t.uncertainty = cue->error();
   }
   t.measured = true;
   t.up = (leveling.inverse() * Eigen::Vector3d::UnitZ()).normalized();

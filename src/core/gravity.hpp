@@ -12,8 +12,17 @@ struct Tilt {
   bool measured = false;              ///< enough flat surfaces to tell; if not, the rest means nothing
   double angle = 0;                   ///< between the map's z axis and `up` [rad]
   Eigen::Vector3d up{0.0, 0.0, 1.0};  ///< the estimated up direction in the map frame (unit, z >= 0)
-  size_t floor_patches = 0;           ///< flat patches facing up (floors, ceilings, ground)
-  size_t wall_patches = 0;            ///< flat patches facing sideways (walls)
+  /// The standard error of `angle` [rad]: the spread of the cue's normals
+  /// about `up` over the square root of their count.
+  double uncertainty = 0;
+  /// What `up` was read from: floors (and ground, ceilings), or walls where
+  /// there are too few floors.
+  enum class Cue { floors, walls } cue = Cue::floors;
+  size_t floor_patches = 0;  ///< flat patches facing up (floors, ceilings, ground)
+  size_t wall_patches = 0;   ///< flat patches facing sideways (walls)
+
+  /// Whether the estimate is good to level by: within `tolerance` at three standard errors.
+  bool levelable(double tolerance) const { return measured && 3.0 * uncertainty <= tolerance; }
 
   /// The rotation that makes the map level: it turns `up` onto z (the
   /// smallest such rotation: no yaw is added).
@@ -24,13 +33,12 @@ struct Tilt {
 /// 16-48 degrees): such a map is refused, never levelled.
 const double kMaxLevelable = radians(30.0);
 
-/// Tilt from the flat surfaces of a (voxel-filtered) map: floors and ceilings
-/// face up, walls face sideways. The map is cut into cubes a few grid cells
-/// wide; each flat cube gives a normal; `up` is the direction closest to the
-/// floor normals and farthest from the wall normals (largest eigenvector of
-/// sum(floor n n^T) - sum(wall n n^T)), found from z in a few rounds, then
-/// again in the frame levelled so far. Within 0.02 degrees up to 35 degrees on
-/// a synthetic building. On sloping ground it reads the slope.
+/// Tilt from the flat surfaces of a map: floors and ceilings face up, walls
+/// face sideways. The map is cut into cubes a few grid cells wide; each flat
+/// cube gives a normal; `up` is the floors' mean normal, or the direction the
+/// walls' normals avoid where there are too few floors; found from z in a few
+/// rounds, then again in the frame levelled so far. On sloping ground it reads
+/// the slope.
 Tilt estimateTilt(const Points& map, double grid);
 
 /// Rotates every point by `rotation` (about the origin).

@@ -120,13 +120,16 @@ void matchSlices(MatchResult& r, const MapFeatures& target, const MapFeatures& s
 }  // namespace
 
 std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string& role, const MatchParams& params) {
-  if (map.leveled || !map.tilt.measured || map.tilt.angle <= params.max_tilt) return std::nullopt;
-  const std::string tilted = role + " map is tilted " + fixed(degrees(map.tilt.angle), 1) + " deg from gravity";
-  if (params.level)  // asked to level, and still tilted: beyond what levelling trusts
+  const Tilt& tilt = map.tilt;
+  if (map.leveled || !tilt.measured || tilt.angle <= params.max_tilt) return std::nullopt;
+  const std::string tilted = role + " map is tilted " + fixed(degrees(tilt.angle), 1) + " +- " +
+                             fixed(degrees(tilt.uncertainty), 1) + " deg from gravity (matched as it is up to " +
+                             fixed(degrees(params.max_tilt), 1) + " deg)";
+  if (!params.level) return tilted + "; levelling is off: level the map first";
+  if (tilt.angle > kMaxLevelable)
     return tilted + ", too far to level (limit " + fixed(degrees(kMaxLevelable), 0) +
            " deg): its axes may be swapped (y up); fix its frame";
-  return tilted + " (limit " + fixed(degrees(params.max_tilt), 1) +
-         " deg): its slices would cut walls at a slant; level it first (tomomap match --level)";
+  return tilted + ", not measured well enough to level (its flat surfaces disagree): level it by its IMU first";
 }
 
 MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings, size_t* filtered_points) {
@@ -146,7 +149,8 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   const Tilt tilt = tilt_estimate.get();
   // Only a map that would be refused: levelling a level map by the estimate's
   // own error (0.6 deg on demo-pcd1) cost 3 cm and 0.6 deg on demo-room.
-  const bool level = params.level && tilt.measured && tilt.angle > params.max_tilt && tilt.angle <= kMaxLevelable;
+  const bool level = params.level && tilt.angle > params.max_tilt && tilt.angle <= kMaxLevelable &&
+                     tilt.levelable(params.max_tilt);
   if (level) {
     // The levelled map is filtered again: rotated voxels no longer sit on the grid.
     filtered = voxelFilter(rotatePoints(filtered, tilt.leveling()), params.grid);

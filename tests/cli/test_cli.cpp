@@ -287,7 +287,7 @@ TEST(Cli, FleetKeysMakesAFleetAndRefusesBadRequests) {
   EXPECT_TRUE(std::filesystem::exists(dir / "fleet/crl.pem"));
 }
 
-TEST(Cli, ATiltedSynthMapIsRefusedAndLevelledOnRequest) {
+TEST(Cli, ATiltedSynthMapIsLevelledAndRefusedWithNoLevel) {
   // A 10 degree roll once came out as a reliable answer 0.6 m off.
   TempDir dir;
   const auto gen = runTomomap("synth -o " + (dir / "w") + " -s 3 --scale 0.5 --tilt 10");
@@ -296,23 +296,26 @@ TEST(Cli, ATiltedSynthMapIsRefusedAndLevelledOnRequest) {
   const std::string gt =
       " --gt-target " + (dir / "w/map_0-gtpose.txt") + " --gt-source " + (dir / "w/map_1-gtpose.txt");
 
-  const auto refused = runTomomap("match --json " + (dir / "refused.json") + " " + maps);
-  EXPECT_EQ(refused.exit_code, 1) << refused.output;
-  EXPECT_NE(refused.output.find("no reliable match: source map is tilted 10.0 deg from gravity"), std::string::npos)
-      << refused.output;
-  const auto r = nlohmann::json::parse(std::ifstream(dir / "refused.json"));
-  EXPECT_FALSE(r["reliable"].get<bool>());
-  EXPECT_LT(r["tilt_deg"]["target"].get<double>(), 0.5);
-  EXPECT_NEAR(r["tilt_deg"]["source"].get<double>(), 10.0, 0.3);
-
-  const auto levelled = runTomomap("match --level --json " + (dir / "levelled.json") + " " + maps + gt);
+  const auto levelled = runTomomap("match --json " + (dir / "levelled.json") + " " + maps + gt);
   ASSERT_EQ(levelled.exit_code, 0) << levelled.output;
-  EXPECT_NE(levelled.output.find("levelled: it leaned 10.0 deg"), std::string::npos) << levelled.output;
+  EXPECT_NE(levelled.output.find("levelled: it leaned 10.0 +- 0.0 deg from gravity (read off its floors)"),
+            std::string::npos)
+      << levelled.output;
   const auto l = nlohmann::json::parse(std::ifstream(dir / "levelled.json"));
   EXPECT_TRUE(l["error"]["success"].get<bool>()) << l.dump(2);
   EXPECT_LT(l["error"]["translation"].get<double>(), 0.15);
   EXPECT_LT(l["error"]["yaw"].get<double>(), radians(1.0)) << "the whole rotation, roll included";
   EXPECT_TRUE(l.contains("T_target_source_unleveled"));
+  EXPECT_LT(l["tilt_deg"]["target"].get<double>(), 0.5);
+  EXPECT_NEAR(l["tilt_deg"]["source"].get<double>(), 10.0, 0.3);
+
+  const auto refused = runTomomap("match --no-level --json " + (dir / "refused.json") + " " + maps);
+  EXPECT_EQ(refused.exit_code, 1) << refused.output;
+  EXPECT_NE(refused.output.find("no reliable match: source map is tilted 10.0 +- 0.0 deg from gravity"),
+            std::string::npos)
+      << refused.output;
+  EXPECT_NE(refused.output.find("levelling is off"), std::string::npos) << refused.output;
+  EXPECT_FALSE(nlohmann::json::parse(std::ifstream(dir / "refused.json"))["reliable"].get<bool>());
 }
 
 TEST(Cli, VizDrawsAsManySlicePairsAsAskedAndWritesJson) {
