@@ -1,0 +1,98 @@
+// The regression matrix (tests/suites/matrix.toml) as a gate: no family of
+// maps may answer wrong, nor fewer right than it did when its floor below was
+// last raised. A verdict change that breaks a family it was not made for fails
+// here, not in a user's hands (docs/results.md has the whole table).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "support.hpp"
+
+using namespace tomomap;
+
+namespace {
+
+struct FamilyTally {
+  int right = 0, refused = 0, wrong = 0, errors = 0;
+};
+
+/// The fields of one CSV line (eval's rows.csv quotes fields holding commas).
+std::vector<std::string> csvFields(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (c == '"' && quoted && i + 1 < line.size() && line[i + 1] == '"') {
+      out.back() += '"';
+      ++i;
+    } else if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      out.emplace_back();
+    } else {
+      out.back() += c;
+    }
+  }
+  return out;
+}
+
+/// Right / refused / wrong / errors per family, from eval's rows.csv.
+std::map<std::string, FamilyTally> tallies(const std::filesystem::path& rows) {
+  std::ifstream in(rows);
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = csvFields(line);
+  const auto column = [&](const std::string& name) {
+    return static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  const size_t family = column("family"), exit_code = column("exit_code"), success = column("success");
+  std::map<std::string, FamilyTally> out;
+  while (std::getline(in, line)) {
+    const std::vector<std::string> f = csvFields(line);
+    if (f.size() < header.size()) continue;
+    FamilyTally& t = out[f[family]];
+    if (f[success] == "1")
+      ++t.right;
+    else if (f[exit_code] == "1")
+      ++t.refused;
+    else if (f[exit_code] == "0")
+      ++t.wrong;
+    else
+      ++t.errors;
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(RegressionMatrix, NoFamilyAnswersWrongOrFewerRightThanItsFloor) {
+  // Right answers per family at the last raise of the floors (the matrix's
+  // run in docs/results.md). Real-data families are checked where the data is.
+  const std::map<std::string, int> floor = {
+      {"demo-room g0.05", 2},       {"indoor g0.05 x0.5", 10},     {"indoor g0.1 x0.5", 10},
+      {"indoor g0.1 x0.5 tilt1", 3}, {"indoor g0.1 x0.5 tilt3", 3}, {"indoor g0.1 x0.5 tilt10", 3},
+      {"indoor g0.1 x0.5 tilt30", 2}, {"indoor g0.2", 2},            {"indoor g0.2 x0.5", 10},
+      {"outdoor g0.1 x0.5", 9},     {"outdoor g0.2 x0.5", 10},     {"outdoor g0.5 x0.5", 10},
+      {"room g0.05", 20},           {"room g0.1", 20},             {"sunrgbd-room g0.05", 1},
+      {"sunrgbd-room g0.1", 1},     {"nuscenes-lidar g0.2", 0},    {"kitti-lidar g0.2", 0}};
+  test::TempDir dir;
+  const auto run = test::runTomomap("eval " + std::string(TOMOMAP_SOURCE_DIR) + "/tests/suites/matrix.toml --out " +
+                                    (dir / "matrix"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::map<std::string, FamilyTally> got = tallies(dir.path / "matrix/rows.csv");
+  ASSERT_GE(got.size(), 14u) << "every generated family ran\n" << run.output;
+  for (const auto& [family, t] : got) {
+    SCOPED_TRACE(family);
+    ASSERT_TRUE(floor.count(family)) << "a family with no floor: add it above";
+    EXPECT_EQ(t.wrong, 0);
+    EXPECT_EQ(t.errors, 0);
+    EXPECT_GE(t.right, floor.at(family)) << t.right << " right, " << t.refused << " refused";
+  }
+  if (test::haveDemoRoom()) {
+    EXPECT_EQ(got.size(), floor.size()) << "the real-data families ran too";
+  }
+}
