@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 
 #include "dense_refine.hpp"
 #include "dense_search.hpp"
+#include "pose_evidence.hpp"
 #include "height_offsets.hpp"
 #include "text.hpp"
 
@@ -29,13 +29,6 @@ constexpr double kDenseLead = 1.4;
 /// ahead) and 17 of the 23 right ones (1.22x and more). docs/results.md,
 /// "Small rooms".
 constexpr double kDenseOpinion = 1.2;
-/// A dense pose that lands more than this share as many telling cells in
-/// space the other map saw empty as on its occupancy does not answer or
-/// confirm: the right best poses of room pairs (seeds 1-100, low and high
-/// noise, at 0.1 m cells) landed at most 0.18, the wrong one a held-out pair
-/// answered (seed 208, high noise, g 0.1: 2.75 m off, the right pose not
-/// among the search's candidates) 0.24 (docs/results.md, "Empty space").
-constexpr double kMostContradicted = 0.2;
 /// Pooled occupancy is searched only where its cell stays this fine [m]
 /// (maps at g 0.1 and finer): room pairs were measured up to there.
 constexpr double kCoarsestPooledCell = 0.2;
@@ -46,24 +39,8 @@ constexpr double kCoarsestPooledCell = 0.2;
 /// 1.19x and 1.08x (docs/results.md, "Small rooms").
 constexpr double kPooledAgreement = 1.1;
 
-/// A lead counts only this many standard deviations beyond chance: a pose's
-/// score is a count of cells, and two counts differ by their square roots'
-/// sum by chance alone. On a real RGB-D room (sunrgbd-room-2 at g 0.1) the
-/// pooled search's best pose led 13 to 7 (1.3 sigma) and was 13.9 m off; right
-/// answers on rooms lead by tens of sigma.
-constexpr double kSignificant = 3.0;
-
-/// A pose's telling cells in the other map's empty space, per one landed on
-/// its occupancy.
-double contradiction(const DensePose& p) {
-  return static_cast<double>(p.contradicted) / static_cast<double>(std::max<size_t>(p.telling_inliers, 1));
-}
-
-/// Whether a pose contradicts no more than kMostContradicted.
-bool consistent(const DensePose& p) { return contradiction(p) <= kMostContradicted; }
-
 /// Whether a pose is consistent over at least `min_support` slices.
-bool holds(const DensePose& p, const MatchParams& params) { return consistent(p) && p.support >= params.min_support; }
+bool holds(const DensePose& p, const MatchParams& params) { return holdsOver(p, params.min_support); }
 
 /// What one dense search found, its poses' offsets in the map's own slices.
 struct Opinion {
@@ -89,9 +66,7 @@ struct Opinion {
   /// difference of two counts (found() only): a lead on a handful of cells is
   /// chance.
   double significance() const {
-    const double a = std::max(best().score(), 0.0);
-    const double b = search.poses.size() > 1 ? std::max(search.poses[1].score(), 0.0) : 0.0;
-    return (a - b) / std::sqrt(std::max(a + b, 1.0));
+    return tomomap::significance(best().score(), search.poses.size() > 1 ? search.poses[1].score() : 0.0);
   }
   /// Whether the best pose leads by `by`, beyond chance, and holds (found() only, else false).
   bool leadsBy(double by, const MatchParams& params) const {

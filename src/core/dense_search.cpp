@@ -202,12 +202,23 @@ struct PoseJudge {
 
 }  // namespace
 
+std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& source,
+                                 const std::vector<std::pair<Rigid2D, int>>& poses, const DenseSearchParams& params) {
+  std::vector<DensePose> out;
+  if (poses.empty() || target.partial || source.partial) return out;
+  const PoseJudge judge(target, source, params);
+  for (const auto& [T, offset] : poses) {
+    DensePose p{T, offset, 0};
+    judge.judge(p, judge.forth(landings(judge.source_cells, T, target.grid), offset));
+    out.push_back(p);
+  }
+  return out;
+}
+
 DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                    const DenseSearchParams& params) {
-  const PoseJudge judge(target, source, params);
-  DensePose p{T, offset, 0};
-  judge.judge(p, judge.forth(landings(judge.source_cells, T, target.grid), offset));
-  return p;
+  const std::vector<DensePose> landed = landPoses(target, source, {{T, offset}}, params);
+  return landed.empty() ? DensePose{T, offset, 0} : landed.front();
 }
 
 int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,

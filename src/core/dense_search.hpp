@@ -69,9 +69,16 @@ int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, co
 
 /// The pose (T, offset) judged as the search judges its poses (inliers, telling
 /// cells both ways, what it contradicts), without searching or refining: for a
-/// pose found otherwise, such as the features' answer.
+/// pose found otherwise, such as the features' answer. Nothing landed (all
+/// counts 0) where either stack is partial.
 DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                    const DenseSearchParams& params = {});
+
+/// landPose for several poses (T, offset), the maps' occupancy prepared once;
+/// empty where either stack is partial.
+std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& source,
+                                 const std::vector<std::pair<Rigid2D, int>>& poses,
+                                 const DenseSearchParams& params = {});
 
 /// Correlates the maps' occupancy on a coarse raster at every yaw step, shift
 /// and height offset (FFT per slice pair), then refines the best distinct

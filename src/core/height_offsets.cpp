@@ -17,7 +17,7 @@ ConsensusParams consensusParams(const MatchParams& params) {
 }  // namespace
 
 std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeatures& target, const MapFeatures& source,
-                                      const MatchParams& params) {
+                                      const MatchParams& params, int groups) {
   // Each (target, source) slice pair belongs to exactly one height offset.
   std::map<int, std::vector<size_t>> by_offset;
   for (size_t k = 0; k < table.estimates.size(); ++k)
@@ -25,19 +25,28 @@ std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeat
       by_offset[target.slices[k / table.ns].index - source.slices[k % table.ns].index].push_back(k);
   const ConsensusParams cp = consensusParams(params);
   std::vector<OffsetScore> scores;
-  for (const auto& [offset, members] : by_offset) {
-    std::vector<Rigid2D> estimates;
-    std::vector<double> weights;
-    for (size_t k : members) {
-      estimates.push_back(table.estimates[k].T);
-      weights.push_back(table.estimates[k].inliers);
+  for (auto& [offset, members] : by_offset) {
+    for (int group = 0; group < groups && !members.empty(); ++group) {
+      std::vector<Rigid2D> estimates;
+      std::vector<double> weights;
+      for (size_t k : members) {
+        estimates.push_back(table.estimates[k].T);
+        weights.push_back(table.estimates[k].inliers);
+      }
+      OffsetScore s{offset, findConsensus(estimates, cp, weights), 0};
+      if (group > 0 && s.consensus.support() < 2) break;
+      std::vector<bool> taken(members.size(), false);
+      for (size_t& i : s.consensus.supporters) {
+        taken[i] = true;
+        i = members[i];  // from index into `estimates` to index into the table
+        s.inlier_sum += table.estimates[i].inliers;
+      }
+      scores.push_back(std::move(s));
+      std::vector<size_t> left;
+      for (size_t i = 0; i < members.size(); ++i)
+        if (!taken[i]) left.push_back(members[i]);
+      members = std::move(left);
     }
-    OffsetScore s{offset, findConsensus(estimates, cp, weights), 0};
-    for (size_t& i : s.consensus.supporters) {
-      i = members[i];  // from index into `estimates` to index into the table
-      s.inlier_sum += table.estimates[i].inliers;
-    }
-    scores.push_back(std::move(s));
   }
   return scores;
 }

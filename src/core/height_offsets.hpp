@@ -15,9 +15,12 @@ struct OffsetScore {
   double inlier_sum = 0;  ///< inliers of the supporting pairs
 };
 
-/// One score per height offset that has at least one estimate, by offset.
+/// One score per height offset that has at least one estimate, by offset:
+/// its largest consensus group. With `groups` > 1, then the largest group of
+/// the estimates left, and so on, while a group has two supporters or more
+/// (another answer at the same offset: a building's rooms repeat along it).
 std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeatures& target, const MapFeatures& source,
-                                      const MatchParams& params);
+                                      const MatchParams& params, int groups = 1);
 
 /// Within this many slices of the winner, an offset whose consensus has the
 /// winner's own transform is that alignment smeared over height (walls look

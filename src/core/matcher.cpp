@@ -11,6 +11,7 @@
 #include "offset_search.hpp"
 #include "pair_cache.hpp"
 #include "refine.hpp"
+#include "rival_answers.hpp"
 #include "text.hpp"
 #include "voxel_filter.hpp"
 
@@ -96,9 +97,20 @@ void matchSlices(MatchResult& r, const MapFeatures& target, const MapFeatures& s
     r.reason = "no slice pair produced an estimate";
     return;
   }
-  const OffsetScore& best = *choice.best;
+  OffsetScore best = *choice.best;
   r.runner_up_support = choice.runner_up_support;
   r.runner_up_offset = choice.runner_up_offset;
+  // A weak winner's rivals are weighed on the occupancy: the answer whose
+  // landing holds and clearly outscores the rest, against the answers that
+  // hold too. The full-size building at g 0.2 (seed 3): the winner, a copy
+  // one room along (10 slice pairs), and the right pose at the same offset
+  // (10 too).
+  if (weakWinner(static_cast<int>(best.consensus.support()) - r.runner_up_support, params))
+    if (const auto landed = chooseByLanding(pairs, target, source, params)) {
+      if (!sameAnswer(landed->answer, best, params, source.centre())) best = landed->answer;
+      r.runner_up_support = landed->rival_support;
+      r.runner_up_offset = landed->rival_offset;
+    }
   r.support = static_cast<int>(best.consensus.support());
   r.height_offset = best.offset;
   for (size_t k : best.consensus.supporters)

@@ -1,0 +1,62 @@
+#include "rival_answers.hpp"
+
+#include <algorithm>
+
+#include "pose_evidence.hpp"
+
+namespace tomomap {
+namespace {
+
+/// Answers landed, at most: the right pose of the full-size building at g 0.2
+/// was among the five with most support where the features' winner was a copy.
+constexpr size_t kMostRivals = 8;
+/// Consensus groups looked at per height offset.
+constexpr int kGroupsPerOffset = 3;
+
+}  // namespace
+
+bool sameAnswer(const OffsetScore& a, const OffsetScore& b, const MatchParams& params, const Eigen::Vector2d& centre) {
+  const ConsensusParams same{params.consensus_translation_cells * params.grid, params.consensus_yaw};
+  return std::abs(a.offset - b.offset) <= kSmearSlices && agree(a.consensus.mean, b.consensus.mean, same, centre);
+}
+
+std::optional<LandedChoice> chooseByLanding(const SlicePairTable& table, const MapFeatures& target,
+                                            const MapFeatures& source, const MatchParams& params) {
+  if (target.occupancy.partial || source.occupancy.partial) return std::nullopt;
+  std::vector<OffsetScore> groups = scoreOffsets(table, target, source, params, kGroupsPerOffset);
+  std::stable_sort(groups.begin(), groups.end(), [](const OffsetScore& a, const OffsetScore& b) {
+    if (a.consensus.support() != b.consensus.support()) return a.consensus.support() > b.consensus.support();
+    return a.inlier_sum > b.inlier_sum;
+  });
+  std::vector<OffsetScore> answers;
+  for (OffsetScore& g : groups) {
+    if (answers.size() == kMostRivals) break;
+    const bool seen = std::any_of(answers.begin(), answers.end(),
+                                  [&](const OffsetScore& a) { return sameAnswer(a, g, params, source.centre()); });
+    if (!seen) answers.push_back(std::move(g));
+  }
+  if (answers.size() < 2) return std::nullopt;
+
+  std::vector<std::pair<Rigid2D, int>> poses;
+  for (const OffsetScore& a : answers) poses.emplace_back(a.consensus.mean, a.offset);
+  const std::vector<DensePose> landed = landPoses(target.occupancy, source.occupancy, poses);
+  if (landed.size() != answers.size()) return std::nullopt;
+  std::vector<size_t> order(answers.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return landed[a].score() > landed[b].score(); });
+  const DensePose& best = landed[order[0]];
+  if (!holdsOver(best, params.min_support) ||
+      significance(best.score(), landed[order[1]].score()) < kSignificant)
+    return std::nullopt;
+  LandedChoice c{answers[order[0]]};
+  for (size_t i = 1; i < order.size(); ++i)
+    if (holdsOver(landed[order[i]], params.min_support) &&
+        static_cast<int>(answers[order[i]].consensus.support()) > c.rival_support) {
+      c.rival_support = static_cast<int>(answers[order[i]].consensus.support());
+      c.rival_offset = answers[order[i]].offset;
+    }
+  return c;
+}
+
+}  // namespace tomomap
