@@ -34,18 +34,6 @@ Eigen::Vector3d inlierSpread(const Refined& r) {
   return (sq / static_cast<double>(r.inliers.size()) - mean.cwiseProduct(mean)).cwiseMax(0.0).cwiseSqrt();
 }
 
-/// Whether another answer (see OffsetChoice) explains the maps about as well as
-/// the winner. Its lead must itself be a reliable support: on small rooms a
-/// wrong transform, repeated over a few similar slices, won 3-5 to 2-4 against
-/// another wrong one, while right matches (synth indoor and outdoor, seeds
-/// 1-4 at every noise level, demo-room both ways at g 0.05-0.15) led by 4 or
-/// more. And it must lead by a share: two identical floors gave 30 vs 29.
-bool ambiguous(const MatchResult& r, const MatchParams& params) {
-  constexpr double kClearAhead = 1.25;  ///< the runner-up must have less than 1 / this of the support
-  return r.runner_up_support > 0 && (r.support - r.runner_up_support < params.min_support ||
-                                     static_cast<double>(r.support) < kClearAhead * r.runner_up_support);
-}
-
 /// p_target = R_target^-1 T R_source p_source, with R a map's levelling rotation.
 Eigen::Matrix4d unleveled(const Pose4& T, const MapFeatures& target, const MapFeatures& source) {
   const auto rotation = [](const MapFeatures& m) {
@@ -56,29 +44,14 @@ Eigen::Matrix4d unleveled(const Pose4& T, const MapFeatures& target, const MapFe
   return rotation(target).inverse() * T.matrix() * rotation(source);
 }
 
-/// "No reliable match" and why, or reliable.
-void judge(MatchResult& r, const MatchParams& params) {
-  if (r.support < params.min_support)
-    r.reason =
-        "only " + std::to_string(r.support) + " slice pairs agree (need " + std::to_string(params.min_support) + ")";
-  else if (ambiguous(r, params))
-    r.reason = "ambiguous: another answer " + std::to_string(std::abs(r.runner_up_offset - r.height_offset)) +
-               " slices away has almost as much support (" + std::to_string(r.support) + " vs " +
-               std::to_string(r.runner_up_support) + " slice pairs)";
-  else if (r.inliers < static_cast<size_t>(params.min_inliers))
-    r.reason = "only " + std::to_string(r.inliers) + " inlier correspondences (need " +
-               std::to_string(params.min_inliers) + ")";
-  else
-    r.reliable = true;
-}
-
-/// The tomographic match of two maps' feature stacks, judged: into `r`.
-void matchSlices(MatchResult& r, const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
-                 const Progress& progress, PairCache* cache) {
+/// The tomographic match of two maps' feature stacks: its figures into `r`,
+/// what the verdict weighs of them into `e`.
+void matchSlices(MatchResult& r, FeatureEvidence& e, const MapFeatures& target, const MapFeatures& source,
+                 const MatchParams& params, const Progress& progress, PairCache* cache) {
   const size_t nt = target.slices.size(), ns = source.slices.size();
   if (nt < static_cast<size_t>(params.min_support) || ns < static_cast<size_t>(params.min_support)) {
-    r.reason = "too few descriptive slices (target " + std::to_string(nt) + ", source " + std::to_string(ns) +
-               "; need " + std::to_string(params.min_support) + ")";
+    e.missing = "too few descriptive slices (target " + std::to_string(nt) + ", source " + std::to_string(ns) +
+                "; need " + std::to_string(params.min_support) + ")";
     return;
   }
   auto t0 = Clock::now();
@@ -94,7 +67,7 @@ void matchSlices(MatchResult& r, const MapFeatures& target, const MapFeatures& s
   const OffsetChoice choice = pickOffset(scores, params, source.centre());
   r.timings.consensus = secondsSince(t0);
   if (!choice.best) {
-    r.reason = "no slice pair produced an estimate";
+    e.missing = "no slice pair produced an estimate";
     return;
   }
   OffsetScore best = *choice.best;
@@ -126,7 +99,10 @@ void matchSlices(MatchResult& r, const MapFeatures& target, const MapFeatures& s
                        wrapAngle(refined.T.yaw)};
   r.inliers = refined.inliers.size();
   r.inlier_spread = inlierSpread(refined);
-  judge(r, params);
+  e.support = r.support;
+  e.runner_up_support = r.runner_up_support;
+  e.runner_up_gap = std::abs(r.runner_up_offset - r.height_offset);
+  e.inliers = r.inliers;
 }
 
 }  // namespace
@@ -187,17 +163,19 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   r.source_features = source.featureCount();
   r.target_tilt = target.tilt.measured ? target.tilt.angle : -1.0;
   r.source_tilt = source.tilt.measured ? source.tilt.angle : -1.0;
+  Evidence e;
+  e.grid = target.grid;
   auto tilted = tiltRefusal(target, "target", params);
   if (!tilted) tilted = tiltRefusal(source, "source", params);
   if (tilted) {
-    r.reason = std::move(*tilted);
-    return r;
+    e.tilted = std::move(*tilted);
+  } else {
+    if (std::abs(target.grid - source.grid) > 1e-9)
+      throw InputError("feature sets use different grid sizes (" + std::to_string(target.grid) + " and " +
+                       std::to_string(source.grid) + " m)");
+    matchSlices(r, e.features, target, source, params, progress, cache);
   }
-  if (std::abs(target.grid - source.grid) > 1e-9)
-    throw InputError("feature sets use different grid sizes (" + std::to_string(target.grid) + " and " +
-                     std::to_string(source.grid) + " m)");
-  matchSlices(r, target, source, params, progress, cache);
-  consultDenseSearch(r, target, source, params);
+  settleMatch(r, e, target, source, params);
   if (target.leveled || source.leveled) r.T_target_source_unleveled = unleveled(r.T_target_source, target, source);
   return r;
 }

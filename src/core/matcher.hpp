@@ -44,7 +44,7 @@ struct MatchResult {
   Eigen::Matrix4d matrix() const { return T_target_source_unleveled.value_or(T_target_source.matrix()); }
 
   /// What found T: "features" (the tomographic match) or "dense" (the dense
-  /// search of small maps, dense_opinion.hpp, when the features found no reliable answer or one it overturned).
+  /// search of small maps, when the verdict (verdict.hpp) takes its answer).
   std::string method = "features";
   /// Small maps only: the dense search's winner over its best other pose, in
   /// DensePose::score (dense_search.hpp); 0 when it did not run.
@@ -75,7 +75,10 @@ struct MatchResult {
 
 /// Finds T_target_source from two feature stacks of the same grid size: slice
 /// pairs estimated (slice_pairs.hpp), height offsets scored and the best picked
-/// (height_offsets.hpp), the winner refined (refine.hpp), the answer judged.
+/// (height_offsets.hpp; a weak winner weighed against its rivals,
+/// rival_answers.hpp), the winner refined (refine.hpp), the answer judged by
+/// the verdict (verdict.hpp), which may ask for the dense search of small maps
+/// (dense_opinion.hpp).
 /// With a `cache` (pair_cache.hpp), the slice pairs it remembers from the
 /// last match of these two maps are recalled, not matched again, and it then
 /// remembers this match's: the answer is the same either way.

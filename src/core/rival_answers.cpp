@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "pose_evidence.hpp"
+#include "verdict.hpp"
 
 namespace tomomap {
 namespace {

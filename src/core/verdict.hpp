@@ -1,0 +1,98 @@
+#pragma once
+// The verdict: from what the searches found to an answer, or to "no reliable
+// match" and why. One pure function, decideMatch; every bar it uses is stated
+// here or in verdict.cpp, and nowhere else (docs/algorithm.md, "No reliable
+// match"). The searches gather evidence; the verdict weighs it.
+#include <optional>
+#include <string>
+
+#include "dense_search.hpp"
+#include "match_params.hpp"
+
+namespace tomomap {
+
+/// A pose that lands more than this share as many telling cells in space the
+/// other map saw empty as on its occupancy does not answer or confirm: the
+/// right best poses of room pairs (seeds 1-100, low and high noise, at 0.1 m
+/// cells) landed at most 0.18, the wrong one a held-out pair answered (seed
+/// 208, high noise, g 0.1: 2.75 m off, the right pose not among the search's
+/// candidates) 0.24.
+constexpr double kMostContradicted = 0.2;
+
+/// A lead counts only this many standard deviations beyond chance: a pose's
+/// score is a count of cells, and two counts differ by their square roots'
+/// sum by chance alone. On a real RGB-D room (sunrgbd-room-2 at g 0.1) the
+/// pooled search's best pose led 13 to 7 (1.3 sigma) and was 13.9 m off; right
+/// answers on rooms lead by tens of sigma.
+constexpr double kSignificant = 3.0;
+
+/// A pose's telling cells in the other map's empty space, per one landed on its occupancy.
+double contradiction(const DensePose& p);
+/// Whether a pose contradicts no more than kMostContradicted.
+bool consistent(const DensePose& p);
+/// Whether a pose is consistent over at least `min_support` slices.
+bool holdsOver(const DensePose& p, int min_support);
+/// Score `a` over score `b` in standard deviations of a difference of two
+/// counts (a negative score counts as none).
+double significance(double a, double b);
+
+/// What the tomographic match found (matcher.cpp).
+struct FeatureEvidence {
+  /// Why there is no feature answer at all (too few descriptive slices, no
+  /// slice pair estimated); empty when there is one.
+  std::string missing;
+  int support = 0;            ///< agreeing slice pairs of the winner
+  int runner_up_support = 0;  ///< of the best other answer
+  int runner_up_gap = 0;      ///< slices between the winner's height offset and the runner-up's
+  size_t inliers = 0;         ///< feature correspondences consistent with the refined winner
+};
+
+/// What one dense search found (dense_opinion.cpp), its best pose against the
+/// features' answer where there is one.
+struct DenseEvidence {
+  bool found = false;     ///< searched, and found at least one pose
+  DensePose best;         ///< its best pose (found only)
+  double next_score = 0;  ///< its next pose's score; 0 if it found one only
+  double cell = 0;        ///< of the occupancy searched [m]
+  bool at_features = false;  ///< its best pose is the features' answer (same place, within the smear of heights)
+  double apart = 0, apart_yaw = 0, apart_height = 0;  ///< how far its best pose is from the features' [m, rad, m]
+
+  /// The best pose's score over its next's; 0 where even the best contradicts more than it finds.
+  double lead() const;
+};
+
+/// All the verdict weighs. The optional parts are gathered when the verdict
+/// asks for them (Verdict::needs).
+struct Evidence {
+  std::string tilted;  ///< why a map is too tilted to match (matcher.hpp tiltRefusal); empty if neither is
+  FeatureEvidence features;
+  double grid = 0;                           ///< the maps' grid [m]
+  std::optional<DenseEvidence> at_grid;      ///< the dense search on the maps' own occupancy
+  std::optional<DensePose> features_landed;  ///< the features' answer landed on the maps' own occupancy
+  std::optional<DenseEvidence> pooled;       ///< the dense search on occupancy pooled to twice the cell
+  bool pooled_at_grid_best = false;          ///< the pooled search's best pose is the grid search's
+};
+
+struct Verdict {
+  enum class By { none, features, at_grid, pooled };
+  By by = By::none;    ///< which search's answer is the answer; none: no reliable match
+  std::string reason;  ///< why there is none
+  /// Evidence the verdict needs before it can decide: gather it and ask again.
+  enum class Needs { nothing, search_at_grid, features_landed, pooled_search };
+  Needs needs = Needs::nothing;
+};
+
+/// The verdict on `e`. A feature answer that leads its runner-up clearly
+/// (weakWinner) stands alone. Otherwise the dense search at the map's grid
+/// confirms it (its best pose is the features' and leads by kDenseOpinion),
+/// replaces it (its best pose elsewhere leads by kDenseLead), or refuses it;
+/// a search whose best pose contradicts what the other map saw empty found no
+/// place of its own, and the features' answer then stands if its own landing
+/// holds. A match the features did not answer is answered by a clear dense
+/// pose. Where that leaves no answer and the pooled cell stays fine enough,
+/// the search on pooled occupancy answers with a clear pose of its own, or
+/// with the grid's where the two agree. Every lead must also be beyond chance
+/// (kSignificant) and its pose hold (kMostContradicted, min_support slices).
+Verdict decideMatch(const Evidence& e, const MatchParams& params);
+
+}  // namespace tomomap

@@ -1,0 +1,163 @@
+// The verdict as a truth table: evidence in, which search answers (or why
+// none does, or what it still needs) out. Each row is a rule of
+// docs/algorithm.md, "No reliable match", with the figures that decide it.
+#include <gtest/gtest.h>
+
+#include "core/verdict.hpp"
+
+using namespace tomomap;
+using By = Verdict::By;
+using Needs = Verdict::Needs;
+
+namespace {
+
+/// A feature answer: `support` slice pairs against `runner_up`, 100 inliers.
+FeatureEvidence featureAnswer(int support, int runner_up = 0) {
+  FeatureEvidence f;
+  f.support = support;
+  f.runner_up_support = runner_up;
+  f.runner_up_gap = 12;
+  f.inliers = 100;
+  return f;
+}
+
+/// A landed pose of `telling` cells, `contradicted` in the other map's empty space, on `slices` slices.
+DensePose landed(size_t telling, size_t contradicted = 0, int slices = 10) {
+  DensePose p;
+  p.telling_inliers = telling;
+  p.contradicted = contradicted;
+  p.inliers = telling;
+  p.support = slices;
+  return p;
+}
+
+/// A dense search whose best pose has `best`'s counts, its next scoring `next`.
+DenseEvidence search(const DensePose& best, double next, bool at_features = false, double cell = 0.1) {
+  DenseEvidence d;
+  d.found = true;
+  d.best = best;
+  d.next_score = next;
+  d.at_features = at_features;
+  d.cell = cell;
+  d.apart = 2.5;
+  return d;
+}
+
+struct Row {
+  const char* rule;
+  Evidence evidence;
+  By by;
+  Needs needs;
+  const char* reason;  ///< the reason begins so (by none, needs nothing)
+};
+
+Evidence with(FeatureEvidence f, std::optional<DenseEvidence> grid = std::nullopt, double cell = 0.1) {
+  Evidence e;
+  e.features = std::move(f);
+  e.grid = cell;
+  e.at_grid = std::move(grid);
+  return e;
+}
+
+}  // namespace
+
+TEST(Verdict, TruthTable) {
+  MatchParams params;  // min_support 3, min_inliers 20: weak winners lead by under 15
+  FeatureEvidence none_found;
+  none_found.missing = "no slice pair produced an estimate";
+  FeatureEvidence few_inliers = featureAnswer(30);
+  few_inliers.inliers = 10;
+
+  std::vector<Row> rows;
+  auto add = [&](const char* rule, Evidence e, By by, Needs needs = Needs::nothing, const char* reason = "") {
+    rows.push_back({rule, std::move(e), by, needs, reason});
+  };
+  Evidence tilted = with(featureAnswer(30));
+  tilted.tilted = "source map is tilted 5.0 +- 0.1 deg";
+  add("a tilted map is refused before anything else", tilted, By::none, Needs::nothing, "source map is tilted");
+  add("a strong feature winner stands alone", with(featureAnswer(30, 2)), By::features);
+  add("too few agreeing slice pairs: the dense search is asked", with(featureAnswer(2)), By::none,
+      Needs::search_at_grid);
+  add("a weak winner: the dense search is asked", with(featureAnswer(10, 2)), By::none, Needs::search_at_grid);
+  add("two answers within min_support pairs are ambiguous",
+      with(featureAnswer(6, 4), DenseEvidence{}, 0.2), By::none, Needs::nothing, "ambiguous: another answer 12");
+  add("a winner under 1.25x its runner-up is ambiguous", with(featureAnswer(30, 25), DenseEvidence{}, 0.2),
+      By::none, Needs::nothing, "ambiguous");
+  add("too few inliers", with(few_inliers, DenseEvidence{}, 0.2), By::none, Needs::nothing,
+      "only 10 inlier correspondences (need 20)");
+  add("no dense search possible (large map): a weak winner stands", with(featureAnswer(10, 2), DenseEvidence{}),
+      By::features);
+  add("no dense search possible, no feature answer: refused", with(none_found, DenseEvidence{}), By::none,
+      Needs::nothing, "no slice pair produced an estimate");
+  add("the dense search confirms: its best pose is the features' and leads 1.3x",
+      with(featureAnswer(10, 2), search(landed(1300), 1000, true)), By::features);
+  add("a clear dense pose elsewhere (1.5x) replaces the features' answer",
+      with(featureAnswer(10, 2), search(landed(1500), 1000, false)), By::at_grid);
+  add("a dense pose elsewhere at 1.3x: the two disagree, then the pooled search is asked",
+      with(featureAnswer(10, 2), search(landed(1300), 1000, false)), By::none, Needs::pooled_search);
+  add("the same at a 0.2 m grid (no pooled search): refused as disagreeing",
+      with(featureAnswer(10, 2), search(landed(1300), 1000, false, 0.2), 0.2), By::none, Needs::nothing,
+      "the features and a dense search of the occupancy disagree (1.30x lead for a pose 2.50 m");
+  add("a dense search too close to tell (1.1x) does not confirm",
+      with(featureAnswer(10, 2), search(landed(1100), 1000, true, 0.2), 0.2), By::none, Needs::nothing,
+      "a dense search of the occupancy does not confirm the features' answer (its best pose leads by 1.10x");
+  add("a lead on a handful of cells is chance: 13 to 7 (1.86x) is no answer",
+      with(featureAnswer(1), search(landed(13), 7, false, 0.2), 0.2), By::none, Needs::nothing,
+      "only 1 slice pairs agree (need 3); nor did a dense search");
+  add("a dense best pose on too few slices does not answer",
+      with(featureAnswer(1), search(landed(2000, 0, 2), 1000, false, 0.2), 0.2), By::none, Needs::nothing,
+      "only 1 slice pairs agree");
+  add("a refused feature match is answered by a clear dense pose",
+      with(featureAnswer(1), search(landed(2000), 1000)), By::at_grid);
+  add("a dense best pose that contradicts the empty space: the features' own landing is asked",
+      with(featureAnswer(10, 2), search(landed(1000, 600), 100)), By::none, Needs::features_landed);
+
+  Evidence own_holds = with(featureAnswer(10, 2), search(landed(1000, 600), 100));
+  own_holds.features_landed = landed(15000, 300);
+  add("... and the features' answer stands where its own landing holds (2 %)", own_holds, By::features);
+  Evidence own_fails = with(featureAnswer(10, 2), search(landed(1000, 600), 100), 0.2);
+  own_fails.features_landed = landed(7000, 5000);
+  add("... and is refused where its own landing contradicts (71 %)", own_fails, By::none, Needs::nothing,
+      "a dense search of the occupancy does not confirm the features' answer (its best pose leads by 0.00x");
+
+  Evidence pooled_clear = with(featureAnswer(1), search(landed(1200), 1000), 0.05);
+  pooled_clear.pooled = search(landed(900), 300, false, 0.1);
+  add("the pooled search answers with a clear pose of its own", pooled_clear, By::pooled);
+  Evidence agreeing = with(featureAnswer(1), search(landed(1250), 1000), 0.05);
+  agreeing.pooled = search(landed(1150), 1000, false, 0.1);
+  agreeing.pooled_at_grid_best = true;
+  add("grid (1.25x) and pooled (1.15x) agreeing on one pose answer with the grid's", agreeing, By::at_grid);
+  Evidence apart = agreeing;
+  apart.pooled_at_grid_best = false;
+  add("... but not where their best poses differ", apart, By::none, Needs::nothing,
+      "only 1 slice pairs agree (need 3); nor did a dense search of the occupancy find a clear pose (lead 1.25x, "
+      "need 1.40x); at 0.10 m cells its best pose leads by 1.15x");
+  Evidence pooled_chance = with(featureAnswer(1), search(landed(74), 59, false, 0.1), 0.1);
+  pooled_chance.pooled = search(landed(13), 7, false, 0.2);
+  add("a pooled lead on 13 cells against 7 is chance (the real RGB-D room answered 13.9 m off)", pooled_chance,
+      By::none, Needs::nothing, "only 1 slice pairs agree");
+
+  for (const Row& row : rows) {
+    SCOPED_TRACE(row.rule);
+    const Verdict v = decideMatch(row.evidence, params);
+    EXPECT_EQ(v.by, row.by);
+    EXPECT_EQ(v.needs, row.needs);
+    if (row.by == By::none && row.needs == Needs::nothing) {
+      EXPECT_EQ(v.reason.rfind(row.reason, 0), 0u) << v.reason;
+    } else {
+      EXPECT_TRUE(v.reason.empty()) << v.reason;
+    }
+  }
+}
+
+TEST(Verdict, PoseEvidence) {
+  EXPECT_DOUBLE_EQ(contradiction(landed(100, 20)), 0.2);
+  EXPECT_TRUE(consistent(landed(100, 20)));
+  EXPECT_FALSE(consistent(landed(100, 21)));
+  EXPECT_TRUE(holdsOver(landed(100, 0, 3), 3));
+  EXPECT_FALSE(holdsOver(landed(100, 0, 2), 3));
+  EXPECT_NEAR(significance(13, 7), 6 / std::sqrt(20.0), 1e-12);
+  EXPECT_DOUBLE_EQ(significance(-5, 0), 0);
+  EXPECT_NEAR(search(landed(1300), 1000).lead(), 1.3, 1e-12);
+  EXPECT_DOUBLE_EQ(search(landed(100, 60), 10).lead(), 0) << "a best pose that contradicts more than it finds";
+}
