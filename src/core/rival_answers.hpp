@@ -25,7 +25,8 @@ bool sameAnswer(const OffsetScore& a, const OffsetScore& b, const MatchParams& p
 /// if there is one. Where a building's rooms repeat along it, slice pairs
 /// support a copy a room along as well as the right pose, often more; the copy
 /// lands on walls where the other map saw empty space. Nothing where either
-/// map's occupancy is partial (received as features).
+/// map is not dense-searchable (too large, or its occupancy partial: received
+/// as features).
 std::optional<LandedChoice> chooseByLanding(const SlicePairTable& table, const MapFeatures& target,
                                             const MapFeatures& source, const MatchParams& params);
 
