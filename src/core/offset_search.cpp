@@ -30,7 +30,7 @@ constexpr size_t kSamplesPerOffset = 8;
 /// diagonal, reaches this share of the best full support so far: a sample of
 /// 8 pairs misjudges an offset's support by up to about half (synth street
 /// and building, demo-room), and an answer with 1 / 1.25 of the winner's
-/// support already makes the match ambiguous (matcher.cpp).
+/// support already makes the match ambiguous (verdict.cpp, kClearAhead).
 constexpr double kRivalShare = 0.5;
 
 /// A winner under this many times min_support is checked against every pair:
@@ -95,7 +95,7 @@ std::vector<size_t> nextPairs(const SlicePairTable& table, const Diagonals& diag
   }
   // The support a rival is judged against: the winner's, or for a weak winner
   // the least that brings another answer within min_support pairs of it
-  // (ambiguous, matcher.cpp), an absolute margin the winner's share misses.
+  // (ambiguous, verdict.cpp), an absolute margin the winner's share misses.
   const int judged = weakWinner(best, params) ? best - params.min_support + 1 : best;
   addAround(choice.best->offset, diagonals, todo);
   if (choice.runner_up_support > 0) addAround(choice.runner_up_offset, diagonals, todo);
