@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 build=${BUILD_DIR:-build}
 if [ ! -x "$build/daemon/tomomapd" ]; then
   echo "== first run: installing what is missing and building tomomap and tomomapd (on a fresh 2-core"
-  echo "   machine about 5 min of apt and 3 min of compiling; later runs start in seconds)"
+  echo "   machine 1-5 min of apt, by the mirror, and 2 min of compiling; later runs start in seconds)"
 fi
 TARGETS="tomomap tomomapd" BUILD_PROGRESS=1 scripts/build.sh
 out=demo-out

@@ -48,7 +48,7 @@ export DEBIAN_FRONTEND=noninteractive
 echo "install-deps: ${#missing[@]} of ${#PACKAGES[@]} packages missing: ${missing[*]}"
 echo "install-deps: updating the package lists"
 run $SUDO apt-get update
-echo "install-deps: downloading and installing (a fresh Debian 12 machine takes about 5 min here; apt's log: $log)"
+echo "install-deps: downloading and installing (a fresh Debian 12 machine takes 1-5 min, by the mirror; apt's log: $log)"
 run $SUDO apt-get install -y --no-install-recommends "${missing[@]}"
 echo "install-deps: done in $((SECONDS - start)) s"
 rm -f "$log"
