@@ -29,7 +29,7 @@ Opinion searchAt(const MapFeatures& target, const MapFeatures& source, const Sli
                  int pooling, const MatchParams& params) {
   DenseSearchParams dp;
   dp.threads = matchThreads(params);
-  const ConsensusParams same{params.consensus_translation_cells * t.grid.cell, params.consensus_yaw};
+  const ConsensusParams same = consensusParams(params, t.grid.cell);
   Opinion o{searchDensely(t, s, same, source.centre(), dp), t.grid.cell, pooling, same};
   for (DensePose& p : o.search.poses) p.offset *= pooling;
   if (pooling > 1 && !o.search.poses.empty()) {
@@ -67,12 +67,13 @@ DenseEvidence evidenceOf(const Opinion& o, const MatchResult& r, bool features, 
   return d;
 }
 
-/// `r` answered by the opinion's best pose (`method` "dense").
-void answer(MatchResult& r, const Opinion& o, const MapFeatures& target, const MapFeatures& source) {
+/// `r` answered by the opinion's best pose (`method` "dense"); `e`, the verdict's view of it.
+void answer(MatchResult& r, const Opinion& o, const DenseEvidence& e, const MapFeatures& target,
+            const MapFeatures& source) {
   const DenseSearch& d = o.search;
   const DensePose& best = o.best();
   r.method = "dense";
-  r.dense_lead = DenseEvidence{true, best, o.nextScore()}.lead();
+  r.dense_lead = e.lead();
   r.dense_cell = o.cell;
   r.T_target_source = {best.transform.t.x(), best.transform.t.y(), heightShift(target, source, best.offset),
                        wrapAngle(best.transform.yaw)};
@@ -131,8 +132,8 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
   }
   r.reliable = v.by != Verdict::By::none;
   r.reason = v.reason;
-  if (v.by == Verdict::By::at_grid) answer(r, *at_grid, target, source);
-  if (v.by == Verdict::By::pooled) answer(r, *at_pooled, target, source);
+  if (v.by == Verdict::By::at_grid) answer(r, *at_grid, *e.at_grid, target, source);
+  if (v.by == Verdict::By::pooled) answer(r, *at_pooled, *e.pooled, target, source);
   if (r.reliable) takeOccupancyHeight(r, target, source);
   r.timings.dense = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -5,16 +5,14 @@
 
 namespace tomomap {
 
-namespace {
-
-ConsensusParams consensusParams(const MatchParams& params) {
-  ConsensusParams cp;
-  cp.translation_tolerance = params.consensus_translation_cells * params.grid;
-  cp.yaw_tolerance = params.consensus_yaw;
-  return cp;
+ConsensusParams consensusParams(const MatchParams& params, double cell) {
+  return {params.consensus_translation_cells * cell, params.consensus_yaw};
 }
 
-}  // namespace
+bool outranks(const OffsetScore& a, const OffsetScore& b) {
+  if (a.consensus.support() != b.consensus.support()) return a.consensus.support() > b.consensus.support();
+  return a.inlier_sum > b.inlier_sum;
+}
 
 std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeatures& target, const MapFeatures& source,
                                       const MatchParams& params, int groups) {
@@ -23,7 +21,7 @@ std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeat
   for (size_t k = 0; k < table.estimates.size(); ++k)
     if (table.estimates[k].ok)
       by_offset[target.slices[k / table.ns].index - source.slices[k % table.ns].index].push_back(k);
-  const ConsensusParams cp = consensusParams(params);
+  const ConsensusParams cp = consensusParams(params, params.grid);
   std::vector<OffsetScore> scores;
   for (auto& [offset, members] : by_offset) {
     for (int group = 0; group < groups && !members.empty(); ++group) {
@@ -55,11 +53,9 @@ OffsetChoice pickOffset(const std::vector<OffsetScore>& scores, const MatchParam
                         const Eigen::Vector2d& source_centre) {
   OffsetChoice c;
   if (scores.empty()) return c;
-  c.best = &*std::max_element(scores.begin(), scores.end(), [](const OffsetScore& x, const OffsetScore& y) {
-    if (x.consensus.support() != y.consensus.support()) return x.consensus.support() < y.consensus.support();
-    return x.inlier_sum < y.inlier_sum;
-  });
-  const ConsensusParams cp = consensusParams(params);
+  c.best = &*std::max_element(scores.begin(), scores.end(),
+                               [](const OffsetScore& x, const OffsetScore& y) { return outranks(y, x); });
+  const ConsensusParams cp = consensusParams(params, params.grid);
   for (const auto& s : scores) {
     const int apart = std::abs(s.offset - c.best->offset);
     const bool other_answer =

@@ -15,6 +15,13 @@ struct OffsetScore {
   double inlier_sum = 0;  ///< inliers of the supporting pairs
 };
 
+/// When two estimates are one answer, on occupancy of `cell` metres (the
+/// maps' grid, or a pooled cell): consensus_translation_cells of them, and consensus_yaw.
+ConsensusParams consensusParams(const MatchParams& params, double cell);
+
+/// Whether `a` is the stronger score: more support, then more inliers.
+bool outranks(const OffsetScore& a, const OffsetScore& b);
+
 /// One score per height offset that has at least one estimate, by offset:
 /// its largest consensus group. With `groups` > 1, then the largest group of
 /// the estimates left, and so on, while a group has two supporters or more

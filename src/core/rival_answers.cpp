@@ -16,8 +16,8 @@ constexpr int kGroupsPerOffset = 3;
 }  // namespace
 
 bool sameAnswer(const OffsetScore& a, const OffsetScore& b, const MatchParams& params, const Eigen::Vector2d& centre) {
-  const ConsensusParams same{params.consensus_translation_cells * params.grid, params.consensus_yaw};
-  return std::abs(a.offset - b.offset) <= kSmearSlices && agree(a.consensus.mean, b.consensus.mean, same, centre);
+  return std::abs(a.offset - b.offset) <= kSmearSlices &&
+         agree(a.consensus.mean, b.consensus.mean, consensusParams(params, params.grid), centre);
 }
 
 std::optional<LandedChoice> chooseByLanding(const SlicePairTable& table, const MapFeatures& target,
@@ -26,10 +26,7 @@ std::optional<LandedChoice> chooseByLanding(const SlicePairTable& table, const M
   // the landings cost 90-160 MB and 0.2-0.3 s a match, for answers that were right.
   if (!denseSearchable(target.occupancy) || !denseSearchable(source.occupancy)) return std::nullopt;
   std::vector<OffsetScore> groups = scoreOffsets(table, target, source, params, kGroupsPerOffset);
-  std::stable_sort(groups.begin(), groups.end(), [](const OffsetScore& a, const OffsetScore& b) {
-    if (a.consensus.support() != b.consensus.support()) return a.consensus.support() > b.consensus.support();
-    return a.inlier_sum > b.inlier_sum;
-  });
+  std::stable_sort(groups.begin(), groups.end(), outranks);
   std::vector<OffsetScore> answers;
   for (OffsetScore& g : groups) {
     if (answers.size() == kMostRivals) break;

@@ -6,9 +6,8 @@
 
 #include <fstream>
 #include <map>
-#include <sstream>
+#include <nlohmann/json.hpp>
 #include <string>
-#include <vector>
 
 #include "support.hpp"
 
@@ -20,46 +19,19 @@ struct FamilyTally {
   int right = 0, refused = 0, wrong = 0, errors = 0;
 };
 
-/// The fields of one CSV line (eval's rows.csv quotes fields holding commas).
-std::vector<std::string> csvFields(const std::string& line) {
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (c == '"' && quoted && i + 1 < line.size() && line[i + 1] == '"') {
-      out.back() += '"';
-      ++i;
-    } else if (c == '"') {
-      quoted = !quoted;
-    } else if (c == ',' && !quoted) {
-      out.emplace_back();
-    } else {
-      out.back() += c;
-    }
-  }
-  return out;
-}
-
-/// Right / refused / wrong / errors per family, from eval's rows.csv.
+/// Right / refused / wrong / errors per family, from eval's rows.jsonl.
 std::map<std::string, FamilyTally> tallies(const std::filesystem::path& rows) {
   std::ifstream in(rows);
-  std::string line;
-  std::getline(in, line);
-  const std::vector<std::string> header = csvFields(line);
-  const auto column = [&](const std::string& name) {
-    return static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin());
-  };
-  const size_t family = column("family"), exit_code = column("exit_code"), success = column("success");
   std::map<std::string, FamilyTally> out;
-  while (std::getline(in, line)) {
-    const std::vector<std::string> f = csvFields(line);
-    if (f.size() < header.size()) continue;
-    FamilyTally& t = out[f[family]];
-    if (f[success] == "1")
+  for (std::string line; std::getline(in, line);) {
+    const auto row = nlohmann::json::parse(line);
+    FamilyTally& t = out[row["family"].get<std::string>()];
+    const int exit_code = row["exit_code"].get<int>();
+    if (row["success"].get<bool>())
       ++t.right;
-    else if (f[exit_code] == "1")
+    else if (exit_code == 1)
       ++t.refused;
-    else if (f[exit_code] == "0")
+    else if (exit_code == 0)
       ++t.wrong;
     else
       ++t.errors;
@@ -83,7 +55,7 @@ TEST(RegressionMatrix, NoFamilyAnswersWrongOrFewerRightThanItsFloor) {
   const auto run = test::runTomomap("eval " + std::string(TOMOMAP_SOURCE_DIR) + "/tests/suites/matrix.toml --out " +
                                     (dir / "matrix"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  const std::map<std::string, FamilyTally> got = tallies(dir.path / "matrix/rows.csv");
+  const std::map<std::string, FamilyTally> got = tallies(dir.path / "matrix/rows.jsonl");
   ASSERT_GE(got.size(), 14u) << "every generated family ran\n" << run.output;
   for (const auto& [family, t] : got) {
     SCOPED_TRACE(family);
