@@ -73,7 +73,7 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   if (method == "tomomap")
     argv = {siblingBinary("tomomap"), "match", "-q"};
   else
-    argv = {siblingBinary("tomomap-baseline")};
+    argv = {siblingBinary("tomomap-baseline"), "--method", method};
   for (const auto& a : {p.target, p.source, std::string("--grid"), std::to_string(p.grid), std::string("--json"), json,
                         std::string("--gt-target"), p.gt_target, std::string("--gt-source"), p.gt_source,
                         std::string("-j"), std::to_string(threads)})
@@ -305,12 +305,13 @@ int runEval(const EvalOptions& o) {
 
 Command addEvalCommand(CLI::App& app) {
   auto o = std::make_shared<EvalOptions>();
-  CLI::App* sub = app.add_subcommand("eval", "Run every pair of a suite through tomomap and the FPFH-RANSAC baseline.");
+  CLI::App* sub =
+      app.add_subcommand("eval", "Run every pair of a suite through tomomap and the methods it is measured against.");
   sub->add_option("SUITE", o->suite, "suite file (TOML): [[pair]], [[synth]] and [[scan]] tables")->required();
   sub->add_option("-o,--out", o->out, "output directory (rows.csv, rows.jsonl, summary.md, boxplots.png, worlds/)")
       ->capture_default_str();
-  sub->add_option("-m,--methods", o->methods, "override the suite's methods (tomomap, fpfh-ransac)")
-      ->check(CLI::IsMember({"tomomap", "fpfh-ransac"}));
+  sub->add_option("-m,--methods", o->methods, "override the suite's methods (tomomap, fpfh-ransac, paper-consensus)")
+      ->check(CLI::IsMember(kEvalMethods));
   sub->add_option("-j,--threads", o->threads, "threads per match (0 = all cores)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));

@@ -26,7 +26,7 @@ int runViz(const VizOptions& o) {
   const double g = o.files.params.grid;
   std::optional<GroundTruthCheck> gt;
   if (m.P_target && m.P_source) gt = checkAgainstGroundTruth(r, *m.P_target, *m.P_source, g);
-  const int code = report(r, m.P_target, m.P_source, g, {o.files.json, false, o.files.quiet}, m.inputs);
+  const int code = report(r, m.P_target, m.P_source, g, {o.files.json, "tomomap", o.files.quiet}, m.inputs);
 
   const auto& T = r.T_target_source;
   std::vector<std::string> caption{

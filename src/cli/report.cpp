@@ -49,14 +49,15 @@ std::string resultLine(const MatchResult& r) {
                 degrees(T.yaw));
 }
 
-void printResult(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& gt, bool baseline) {
+void printResult(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& gt,
+                 const std::string& method) {
   out << resultLine(r) << "\n";
   if (r.reliable) {
     if (r.T_target_source_unleveled) out << "  between the levelled maps; in the maps' own frames:\n";
     const Eigen::Matrix4d M = r.matrix();
     for (int i = 0; i < 4; ++i) out << format("  [%9.5f %9.5f %9.5f %9.4f]\n", M(i, 0), M(i, 1), M(i, 2), M(i, 3));
   }
-  if (baseline) {
+  if (method == "fpfh-ransac") {
     out << format("keypoints        target %zu, source %zu, %zu inliers\n", r.target_features, r.source_features,
                   r.inliers);
     out << format("time             %.3f s: normals + FPFH %.3f, RANSAC %.3f\n", r.timings.total(), r.timings.features,
@@ -144,12 +145,12 @@ int report(const MatchResult& r, const std::optional<Eigen::Matrix4d>& P_target,
   if (how.quiet)
     text << resultLine(r) << "\n";
   else
-    printResult(text, r, gt, how.baseline);
+    printResult(text, r, gt, how.method);
   if (!how.json.empty()) {
     auto j = toJson(r, gt);
     j["schema_version"] = kJsonSchemaVersion;
-    j["tool"] = {{"name", how.baseline ? "tomomap-baseline" : "tomomap"}, {"version", TOMOMAP_VERSION}};
-    j["method"] = how.baseline ? "fpfh-ransac" : "tomomap";
+    j["tool"] = {{"name", how.method == "tomomap" ? "tomomap" : "tomomap-baseline"}, {"version", TOMOMAP_VERSION}};
+    j["method"] = how.method;
     j["grid"] = grid;
     if (extra.is_object()) j.update(extra);
     if (json_to_stdout) {

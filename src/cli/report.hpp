@@ -20,9 +20,9 @@ struct GroundTruthCheck {
 GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const Eigen::Matrix4d& P_target,
                                          const Eigen::Matrix4d& P_source, double grid);
 
-/// `baseline` prints the FPFH-RANSAC result's keypoints instead of slices.
+/// `method` names what found `r`: "fpfh-ransac" prints keypoints instead of slices.
 void printResult(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& gt,
-                 bool baseline = false);
+                 const std::string& method = "tomomap");
 
 nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck>& gt);
 
@@ -30,7 +30,7 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
 /// stdout, the text then goes to stderr), `quiet` the text as one line.
 struct ReportOptions {
   std::string json;
-  bool baseline = false;
+  std::string method = "tomomap";  ///< tomomap, or a baseline's name (tomomap-baseline --method)
   bool quiet = false;
 };
 

@@ -93,8 +93,9 @@ Suite loadSuite(const std::string& path) {
   s.name = text(path, root, "name", "the suite", fs::path(path).stem().string());
   s.methods = list<std::string>(path, root, "methods", s.methods);
   for (const auto& m : s.methods)
-    if (m != "tomomap" && m != "fpfh-ransac")
-      fail(path, root.get("methods")->source(), "unknown method '" + m + "' (use tomomap or fpfh-ransac)");
+    if (std::find(kEvalMethods.begin(), kEvalMethods.end(), m) == kEvalMethods.end())
+      fail(path, root.get("methods")->source(),
+           "unknown method '" + m + "' (use tomomap, fpfh-ransac or paper-consensus)");
 
   forEachTable(path, root, "pair", [&](const toml::table& t) {
     checkKeys(path, t, {"name", "target", "source", "gt_target", "gt_source", "grid", "family"}, "[[pair]]");

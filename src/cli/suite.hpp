@@ -37,6 +37,10 @@ struct SuiteScan {
   std::vector<std::string> methods;  ///< as for [[synth]]
 };
 
+/// Every method a suite may name: tomomap, and the baselines it is measured
+/// against (tomomap-baseline --method).
+inline const std::vector<std::string> kEvalMethods{"tomomap", "fpfh-ransac", "paper-consensus"};
+
 struct Suite {
   std::string name;
   std::vector<std::string> methods{"tomomap", "fpfh-ransac"};

@@ -1,0 +1,48 @@
+#include "paper_consensus.hpp"
+
+#include <chrono>
+
+#include "core/height_offsets.hpp"
+#include "core/offset_search.hpp"
+
+namespace tomomap::baseline {
+
+MatchResult matchPaperConsensus(const Points& target, const Points& source, MatchParams params) {
+  params.exhaustive = true;  // the paper visits every slice pair once
+  params.level = false;      // and takes the maps as they are
+  MatchResult r;
+  const MapFeatures t = describeMap(target, params, &r.timings), s = describeMap(source, params, &r.timings);
+  r.target_slices = t.slice_count;
+  r.source_slices = s.slice_count;
+  r.target_features = t.featureCount();
+  r.source_features = s.featureCount();
+  r.target_tilt = t.tilt.measured ? t.tilt.angle : -1;
+  r.source_tilt = s.tilt.measured ? s.tilt.angle : -1;
+  if (t.slices.empty() || s.slices.empty()) {
+    r.reason = "a map has no descriptive slice";
+    return r;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const SlicePairTable pairs = matchSlicePairs(t, s, params, {});
+  r.slice_pairs = pairs.matchedCount();
+  r.slice_pairs_total = t.slices.size() * s.slices.size();
+  const std::vector<OffsetScore> scores = scoreOffsets(pairs, t, s, params);
+  const OffsetChoice choice = pickOffset(scores, params, s.centre());
+  r.timings.pair_matching = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!choice.best) {
+    r.reason = "no slice pair produced an estimate";
+    return r;
+  }
+  // The winning offset's consensus: the mean of its agreeing estimates.
+  const OffsetScore& best = *choice.best;
+  r.reliable = true;
+  r.support = static_cast<int>(best.consensus.support());
+  r.runner_up_support = choice.runner_up_support;
+  r.runner_up_offset = choice.runner_up_offset;
+  r.height_offset = best.offset;
+  r.T_target_source = {best.consensus.mean.t.x(), best.consensus.mean.t.y(), heightShift(t, s, best.offset),
+                       wrapAngle(best.consensus.mean.yaw)};
+  return r;
+}
+
+}  // namespace tomomap::baseline
