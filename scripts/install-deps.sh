@@ -8,6 +8,7 @@ PACKAGES=(
   build-essential cmake pkg-config
   libpcl-dev libopenmpi-dev libeigen3-dev libopencv-dev liboctomap-dev libceres-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
+  cyclonedds-dev cyclonedds-tools  # the tests' ROS 2 node: a second DDS vendor, rmw_cyclonedds's
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
   libssl-dev liblzf-dev
   libgtest-dev libgmock-dev libbenchmark-dev libsystemd-dev zlib1g-dev libpng-dev

@@ -2,6 +2,7 @@
 
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -35,16 +36,55 @@ struct TfStaticPublisher::Impl {
   }
 };
 
+namespace {
+
+/// Participant indices probed on this host: as many as ROS 2's
+/// rmw_cyclonedds lets a host's nodes take (MaxAutoParticipantIndex 32).
+constexpr uint32_t kLocalParticipantIndices = 32;
+
+/// Where the ROS 2 participant looks for ROS 2 nodes (docs/operations.md,
+/// "ROS 2"). Every ROS 2 discovery setting that reaches this host is
+/// served, whichever DDS the nodes use: announcing to loopback at the
+/// well-known port of each participant index finds the nodes that listen
+/// only there (Jazzy's ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST, static
+/// peers on this host); a node bound to loopback (Humble's
+/// ROS_LOCALHOST_ONLY=1) answers to the 127.0.0.1 this participant gives.
+/// `localhost_only` keeps everything on the host: no multicast at all, and
+/// replies only to the addresses local nodes give, which are this host's own
+/// (the kernel delivers those on loopback: nothing reaches the robots' link).
+/// Otherwise Fast DDS's multicast discovery finds the nodes of the network too
+/// (ROS 2's defaults), loopback besides.
+void configureDiscovery(DomainParticipantQos& q, int ros_domain, bool localhost_only) {
+  using eprosima::fastrtps::rtps::IPLocator;
+  using eprosima::fastrtps::rtps::Locator_t;
+  Locator_t loopback;
+  IPLocator::setIPv4(loopback, 127, 0, 0, 1);
+  auto& builtin = q.wire_protocol().builtin;
+  builtin.initialPeersList.push_back(loopback);
+  auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  udp->maxInitialPeersRange = kLocalParticipantIndices;
+  q.transport().use_builtin_transports = false;
+  q.transport().user_transports.push_back(udp);
+  q.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+  if (localhost_only) {
+    builtin.metatrafficMulticastLocatorList.clear();
+    builtin.metatrafficUnicastLocatorList.push_back(loopback);
+    q.wire_protocol().default_unicast_locator_list.push_back(loopback);
+  } else {
+    // The initial peers replace Fast DDS's default one, its multicast group.
+    Locator_t multicast;
+    IPLocator::setIPv4(multicast, 239, 255, 0, 1);
+    multicast.port = q.wire_protocol().port.getMulticastPort(static_cast<uint32_t>(ros_domain));
+    builtin.initialPeersList.push_back(multicast);
+  }
+}
+
+}  // namespace
+
 TfStaticPublisher::TfStaticPublisher(int ros_domain, bool localhost_only) : impl_(std::make_unique<Impl>()) {
   DomainParticipantQos q;
   q.name("tomomapd_tf");
-  if (localhost_only) {
-    q.transport().use_builtin_transports = false;
-    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
-    udp->interfaceWhiteList.emplace_back("127.0.0.1");
-    q.transport().user_transports.push_back(udp);
-    q.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
-  }
+  configureDiscovery(q, ros_domain, localhost_only);
   auto& i = *impl_;
   i.participant = DomainParticipantFactory::get_instance()->create_participant(ros_domain, q);
   if (!i.participant)

@@ -23,9 +23,10 @@ Eigen::Vector4d yawQuaternion(double yaw);
 
 class TfStaticPublisher {
  public:
-  /// `localhost_only`: the participant uses the loopback interface and shared
-  /// memory only (as ROS_LOCALHOST_ONLY=1), so nothing of it reaches the
-  /// robots' thin link. Throws std::runtime_error if DDS refuses.
+  /// `localhost_only`: the participant reaches ROS 2 nodes on this host only,
+  /// under any of ROS 2's local discovery settings, and nothing of it reaches
+  /// the robots' thin link; otherwise the network's nodes too, by multicast
+  /// (tf_static.cpp, configureDiscovery). Throws std::runtime_error if DDS refuses.
   TfStaticPublisher(int ros_domain, bool localhost_only);
   ~TfStaticPublisher();
   TfStaticPublisher(const TfStaticPublisher&) = delete;

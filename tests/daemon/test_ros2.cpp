@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -13,6 +14,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <map>
+#include <sstream>
 
 #include "fleet.hpp"
 #include "ros2_tfPubSubTypes.h"
@@ -135,5 +137,102 @@ TEST(Ros2, TheFleetsFramesAreOneTreeOnTfStatic) {
     EXPECT_EQ(parent_of.size(), 2u);
   }
   EXPECT_NE(fleet.log("bravo").find("ROS 2: /tf_static holds 2"), std::string::npos) << fleet.log("bravo");
+  stopAll(fleet, ids);
+}
+
+namespace {
+
+/// A ROS 2 discovery setting as rmw_cyclonedds_cpp configures Cyclone DDS for it.
+struct Ros2Setting {
+  std::string name;
+  std::string cyclonedds_uri;  ///< what rmw_cyclonedds builds (empty: Cyclone's defaults)
+};
+
+std::string cyclone(const std::string& inside) { return "<CycloneDDS><Domain>" + inside + "</Domain></CycloneDDS>"; }
+
+/// Humble's ROS_LOCALHOST_ONLY=1: the loopback interface alone.
+const Ros2Setting kHumbleLocalhostOnly{
+    "ROS_LOCALHOST_ONLY=1 (Humble)",
+    cyclone("<General><NetworkInterfaceAddress>127.0.0.1</NetworkInterfaceAddress></General>")};
+/// Jazzy's LOCALHOST range: no multicast, localhost as a static peer.
+const Ros2Setting kJazzyLocalhost{"ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST (Jazzy)",
+                                  cyclone("<General><AllowMulticast>false</AllowMulticast></General><Discovery>"
+                                          "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32</"
+                                          "MaxAutoParticipantIndex><Peers><Peer address=\"localhost\"/></Peers></"
+                                          "Discovery>")};
+/// Jazzy's SUBNET range with ROS_STATIC_PEERS=127.0.0.1: multicast, and the peer.
+const Ros2Setting kJazzySubnetStaticPeer{
+    "ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET, ROS_STATIC_PEERS=127.0.0.1 (Jazzy)",
+    cyclone("<Discovery><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>32</"
+            "MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers></Discovery>")};
+/// ROS 2's defaults (Humble's, and Jazzy's SUBNET range): multicast on the network.
+const Ros2Setting kDefaults{"the defaults (Humble; Jazzy's SUBNET)", ""};
+
+/// The last sample a Cyclone DDS reader under `setting` took from rt/tf_static
+/// on `domain` once one held `transforms` transforms; null if none came.
+nlohmann::json readWithCyclone(const Ros2Setting& setting, int domain, size_t transforms, std::string& output) {
+  const auto r = runBinary("env", "CYCLONEDDS_URI='" + setting.cyclonedds_uri + "' " CYCLONE_TF_READER_BIN " " +
+                                      std::to_string(domain) + " " + std::to_string(transforms) + " 120");
+  output = r.output;
+  nlohmann::json last;
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);)
+    if (!line.empty() && line[0] == '{') last = nlohmann::json::parse(line);
+  return r.exit_code == 0 ? last : nlohmann::json();
+}
+
+}  // namespace
+
+// The check no one here wrote the other half of: Eclipse Cyclone DDS, the DDS
+// of ROS 2's rmw_cyclonedds, with ROS 2's message types from their .msg files,
+// configured as rmw_cyclonedds configures it for each discovery setting. One
+// daemon with `localhost_only = true` (the default) must serve every setting
+// that keeps ROS 2 on the robot, the other (`false`) ROS 2's network defaults.
+TEST(Ros2, ACycloneDdsNodeReadsTfStaticUnderEachDiscoverySetting) {
+  TempDir dir;
+  const auto gen = runTomomap("synth -o " + (dir / "world") + " -n 2 --noise low -s 4 --scale 0.5");
+  ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  // ROS 2 domains of this test's own (their ports stay below 65536 up to 232).
+  const int local_domain = 150 + static_cast<int>(::getpid() % 40), network_domain = local_domain + 40;
+  Fleet fleet(dir);
+  std::vector<AgentSpec> agents{{"alpha", dir / "world/map_0.pcd"}, {"bravo", dir / "world/map_1.pcd"}};
+  agents[0].extra = "[ros2]\ndomain = " + std::to_string(local_domain) + "\nframe = \"{agent}_map\"\n";
+  agents[1].extra =
+      "[ros2]\ndomain = " + std::to_string(network_domain) + "\nframe = \"{agent}_map\"\nlocalhost_only = false\n";
+  for (const auto& a : agents) fleet.start(a, agents);
+  const std::vector<std::string> ids{"alpha", "bravo"};
+  ASSERT_TRUE(fleet.waitForTransforms(ids, 1, 300s)) << fleet.log("alpha") << fleet.log("bravo");
+  const nlohmann::json frame = fleet.readJson("alpha", "frame.json");
+  Pose4 bravo;
+  bool placed = false;
+  for (const auto& a : frame["agents"])
+    if (a["agent"] == "bravo")
+      bravo = {a["T_reference_agent"]["x"].get<double>(), a["T_reference_agent"]["y"].get<double>(),
+               a["T_reference_agent"]["z"].get<double>(), a["T_reference_agent"]["yaw"].get<double>()},
+      placed = true;
+  ASSERT_TRUE(placed) << frame.dump(2);
+
+  const std::vector<std::pair<Ros2Setting, int>> cases{{kHumbleLocalhostOnly, local_domain},
+                                                       {kJazzyLocalhost, local_domain},
+                                                       {kJazzySubnetStaticPeer, local_domain},
+                                                       {kDefaults, network_domain},
+                                                       {kJazzyLocalhost, network_domain}};
+  for (const auto& [setting, domain] : cases) {
+    SCOPED_TRACE(setting.name + (domain == local_domain ? ", localhost_only = true" : ", localhost_only = false"));
+    std::string output;
+    const nlohmann::json got = readWithCyclone(setting, domain, 1, output);
+    ASSERT_FALSE(got.is_null()) << "nothing on rt/tf_static\n" << output;
+    ASSERT_EQ(got["transforms"].size(), 1u) << got.dump();
+    const auto& t = got["transforms"][0];
+    EXPECT_EQ(t["parent"], "alpha_map");
+    EXPECT_EQ(t["child"], "bravo_map");
+    EXPECT_NEAR(t["x"].get<double>(), bravo.x, 1e-9);
+    EXPECT_NEAR(t["y"].get<double>(), bravo.y, 1e-9);
+    EXPECT_NEAR(t["z"].get<double>(), bravo.z, 1e-9);
+    EXPECT_NEAR(2 * std::atan2(t["qz"].get<double>(), t["qw"].get<double>()), bravo.yaw, 1e-9);
+    EXPECT_EQ(t["qx"].get<double>(), 0.0);
+    EXPECT_EQ(t["qy"].get<double>(), 0.0);
+    EXPECT_GT(t["sec"].get<int64_t>(), 1'600'000'000) << "stamped with the wall clock";
+  }
   stopAll(fleet, ids);
 }
