@@ -24,7 +24,7 @@
 #include "rejection_log.hpp"
 #include "results/fleet_frame.hpp"
 #include "transport/bus.hpp"
-#include "transport/tf_static.hpp"
+#include "transport/ros2_node.hpp"
 
 namespace tomomap::daemon {
 
@@ -116,11 +116,14 @@ class Agent {
   void restoreTransforms();
   /// Builds the fleet's frame from the agreed transforms (agent_frame.cpp).
   void updateFrame();
-  /// Creates the /tf_static publisher when [ros2] asks for it (a failure is
-  /// logged: the fleet works on without it).
+  /// Creates the ROS 2 node when [ros2] asks for it (a failure is logged:
+  /// the fleet works on without it).
   void startRos2();
   /// Publishes the fleet frame's tree on /tf_static if it changed.
   void publishTree();
+  /// Publishes `status` (status.json's content) on /diagnostics, once per
+  /// kDiagnosticsPeriod at most.
+  void publishDiagnostics(const nlohmann::json& status);
   /// One line of progress for systemd's STATUS= (and `systemctl status`).
   std::string statusLine() const;
 
@@ -128,8 +131,9 @@ class Agent {
   Log& log_;
   std::unique_ptr<transport::Bus> bus_;
   FleetFrame frame_;  ///< every agent's pose in the reference's map, and each pair's verdict
-  std::unique_ptr<transport::TfStaticPublisher> tf_;
+  std::unique_ptr<transport::Ros2Node> ros2_;
   std::optional<std::vector<TreeEdge>> tf_published_;  ///< what /tf_static holds; none before the first sample
+  std::optional<Clock::time_point> diagnostics_published_;
   transport::BusHandlers handlers_;
   Notifier notifier_;
   std::unique_ptr<MapWatch> watch_;
@@ -156,7 +160,8 @@ class Agent {
   bool transforms_unwritten_ = false;  ///< transforms.json is behind: its last write failed
   std::string write_error_;            ///< why the last write of a state file failed; empty once one succeeds
   RejectionLog rejections_;            ///< warnings for rejected samples, bounded per sender
-  bool reannounce_ = false;            ///< a peer asked for our announcement: announce again (tick, once for peers that ask together)
+  bool reannounce_ =
+      false;  ///< a peer asked for our announcement: announce again (tick, once for peers that ask together)
   Clock::time_point started_ = Clock::now();
 };
 

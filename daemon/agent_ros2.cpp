@@ -1,11 +1,16 @@
-// The fleet's frames on ROS 2's /tf_static: every placed map under the root
-// with its pose in the fleet's frame (results/fleet_frame.hpp), republished
-// whole whenever it changes.
+// What ROS 2 sees of the daemon: the fleet's frames on /tf_static, every
+// placed map under the root with its pose in the fleet's frame
+// (results/fleet_frame.hpp), republished whole whenever it changes; and its
+// health on /diagnostics (diagnostics.hpp).
 #include "agent.hpp"
+#include "diagnostics.hpp"
 
 namespace tomomap::daemon {
 
 namespace {
+
+/// diagnostic_updater's default period: what rqt_robot_monitor expects.
+constexpr auto kDiagnosticsPeriod = std::chrono::seconds(1);
 
 bool sameTree(const std::vector<TreeEdge>& a, const std::vector<TreeEdge>& b) {
   if (a.size() != b.size()) return false;
@@ -21,20 +26,22 @@ bool sameTree(const std::vector<TreeEdge>& a, const std::vector<TreeEdge>& b) {
 }  // namespace
 
 void Agent::startRos2() {
-  tf_.reset();
+  ros2_.reset();
   tf_published_.reset();
+  diagnostics_published_.reset();
   if (!config_.ros2.enabled) return;
   try {
-    tf_ = std::make_unique<transport::TfStaticPublisher>(config_.ros2.domain, config_.ros2.localhost_only);
-    log_.info("ROS 2: publishing the fleet's frames on /tf_static (domain " + std::to_string(config_.ros2.domain) +
-              ", root frame " + config_.ros2.frameOf(config_.treeRoot()) + ")");
+    ros2_ = std::make_unique<transport::Ros2Node>(config_.ros2.domain, config_.ros2.localhost_only);
+    log_.info("ROS 2: publishing the fleet's frames on /tf_static and this daemon's health on /diagnostics (domain " +
+              std::to_string(config_.ros2.domain) + ", root frame " + config_.ros2.frameOf(config_.treeRoot()) + ")");
   } catch (const std::exception& e) {
-    log_.error(std::string("ROS 2: cannot publish /tf_static (") + e.what() + "); transforms.json is still written");
+    log_.error(std::string("ROS 2: cannot publish /tf_static and /diagnostics (") + e.what() +
+               "); transforms.json is still written");
   }
 }
 
 void Agent::publishTree() {
-  if (!tf_) return;
+  if (!ros2_) return;
   uint64_t stamp_ms = 0;  // the newest transform behind the frame
   for (const auto& [key, t] : board_.results())
     if (t.reliable) stamp_ms = std::max(stamp_ms, t.computed_at_ms);
@@ -44,11 +51,19 @@ void Agent::publishTree() {
   std::vector<transport::TfFrame> frames;
   for (const auto& e : tree)
     frames.push_back({config_.ros2.frameOf(e.parent), config_.ros2.frameOf(e.child), e.T_parent_child, e.stamp_ms});
-  tf_->publish(frames);
+  ros2_->publishTfStatic(frames);
   log_.info("ROS 2: /tf_static holds " + std::to_string(frames.size()) + " of the fleet's " +
             std::to_string(config_.transport.peers.size()) + " other frames under " +
             config_.ros2.frameOf(config_.treeRoot()));
   tf_published_ = std::move(tree);
+}
+
+void Agent::publishDiagnostics(const nlohmann::json& status) {
+  if (!ros2_) return;
+  const auto now = Clock::now();
+  if (diagnostics_published_ && now - *diagnostics_published_ < kDiagnosticsPeriod) return;
+  diagnostics_published_ = now;
+  ros2_->publishDiagnostics({diagnosticOf(status, toJson(frame_), statusLine())}, wallMs());
 }
 
 }  // namespace tomomap::daemon

@@ -92,6 +92,7 @@ void Agent::persist(bool transforms_changed) {
         {"secure", config_.transport.security.enabled()},
         {"transforms_unwritten", transforms_unwritten_},
         {"write_error", transforms_unwritten_ ? write_error_ : std::string()}};
+    publishDiagnostics(status);
     writeJsonAtomically((dir / "status.json").string(), status);
     if (!transforms_unwritten_) write_error_.clear();
   } catch (const std::exception& e) {

@@ -17,7 +17,7 @@
 #include <sstream>
 
 #include "fleet.hpp"
-#include "ros2_tfPubSubTypes.h"
+#include "ros2_msgsPubSubTypes.h"
 
 using namespace tomomap;
 using namespace tomomap::test;
@@ -168,11 +168,13 @@ const Ros2Setting kJazzySubnetStaticPeer{
 /// ROS 2's defaults (Humble's, and Jazzy's SUBNET range): multicast on the network.
 const Ros2Setting kDefaults{"the defaults (Humble; Jazzy's SUBNET)", ""};
 
-/// The last sample a Cyclone DDS reader under `setting` took from rt/tf_static
-/// on `domain` once one held `transforms` transforms; null if none came.
-nlohmann::json readWithCyclone(const Ros2Setting& setting, int domain, size_t transforms, std::string& output) {
-  const auto r = runBinary("env", "CYCLONEDDS_URI='" + setting.cyclonedds_uri + "' " CYCLONE_TF_READER_BIN " " +
-                                      std::to_string(domain) + " " + std::to_string(transforms) + " 120");
+/// The last sample a Cyclone DDS reader under `setting` took from rt/`topic`
+/// on `domain` once it was done (`until`: cyclone_ros2_reader's third
+/// argument); null if it never was.
+nlohmann::json readWithCyclone(const Ros2Setting& setting, const std::string& topic, int domain,
+                               const std::string& until, std::string& output) {
+  const auto r = runBinary("env", "CYCLONEDDS_URI='" + setting.cyclonedds_uri + "' " CYCLONE_ROS2_READER_BIN " " +
+                                      topic + " " + std::to_string(domain) + " '" + until + "' 120");
   output = r.output;
   nlohmann::json last;
   std::istringstream lines(r.output);
@@ -188,7 +190,7 @@ nlohmann::json readWithCyclone(const Ros2Setting& setting, int domain, size_t tr
 // configured as rmw_cyclonedds configures it for each discovery setting. One
 // daemon with `localhost_only = true` (the default) must serve every setting
 // that keeps ROS 2 on the robot, the other (`false`) ROS 2's network defaults.
-TEST(Ros2, ACycloneDdsNodeReadsTfStaticUnderEachDiscoverySetting) {
+TEST(Ros2, ACycloneDdsNodeReadsTfStaticUnderEachDiscoverySettingAndDiagnostics) {
   TempDir dir;
   const auto gen = runTomomap("synth -o " + (dir / "world") + " -n 2 --noise low -s 4 --scale 0.5");
   ASSERT_EQ(gen.exit_code, 0) << gen.output;
@@ -220,7 +222,7 @@ TEST(Ros2, ACycloneDdsNodeReadsTfStaticUnderEachDiscoverySetting) {
   for (const auto& [setting, domain] : cases) {
     SCOPED_TRACE(setting.name + (domain == local_domain ? ", localhost_only = true" : ", localhost_only = false"));
     std::string output;
-    const nlohmann::json got = readWithCyclone(setting, domain, 1, output);
+    const nlohmann::json got = readWithCyclone(setting, "tf_static", domain, "1", output);
     ASSERT_FALSE(got.is_null()) << "nothing on rt/tf_static\n" << output;
     ASSERT_EQ(got["transforms"].size(), 1u) << got.dump();
     const auto& t = got["transforms"][0];
@@ -234,5 +236,34 @@ TEST(Ros2, ACycloneDdsNodeReadsTfStaticUnderEachDiscoverySetting) {
     EXPECT_EQ(t["qy"].get<double>(), 0.0);
     EXPECT_GT(t["sec"].get<int64_t>(), 1'600'000'000) << "stamped with the wall clock";
   }
-  stopAll(fleet, ids);
+
+  // /diagnostics, as rqt_robot_monitor reads it: each daemon's health, OK
+  // once its peer is up and their pair agreed.
+  for (const auto& [id, domain] : {std::pair<std::string, int>{"alpha", local_domain}, {"bravo", network_domain}}) {
+    SCOPED_TRACE(id);
+    std::string output;
+    const nlohmann::json got = readWithCyclone(kJazzyLocalhost, "diagnostics", domain, "pairs agreed=1", output);
+    ASSERT_FALSE(got.is_null()) << "no /diagnostics with the pair agreed\n" << output;
+    ASSERT_EQ(got["status"].size(), 1u) << got.dump();
+    const auto& d = got["status"][0];
+    EXPECT_EQ(d["name"], "tomomapd: " + id);
+    EXPECT_EQ(d["hardware_id"], id);
+    EXPECT_EQ(d["level"], 0) << "OK: " << d.dump();
+    EXPECT_EQ(d["values"]["peers up"], "1/1") << d.dump();
+    EXPECT_EQ(d["values"]["pair alpha<-bravo"].get<std::string>().rfind("agreed", 0), 0u) << d.dump();
+    EXPECT_EQ(d["values"]["inconsistent pairs"], "none");
+    EXPECT_EQ(d["values"]["write error"], "none");
+    EXPECT_TRUE(d["values"].contains("map tilt [deg]")) << d.dump();
+    EXPECT_GT(got["sec"].get<int64_t>(), 1'600'000'000) << "stamped with the wall clock";
+  }
+
+  // A peer gone: its daemon's health turns WARN and says why.
+  stopAll(fleet, {"bravo"});
+  std::string output;
+  const nlohmann::json warned = readWithCyclone(kJazzyLocalhost, "diagnostics", local_domain, "peers up=0/1", output);
+  ASSERT_FALSE(warned.is_null()) << "alpha never said bravo is down\n" << output;
+  EXPECT_EQ(warned["status"][0]["level"], 1) << warned.dump();
+  EXPECT_NE(warned["status"][0]["message"].get<std::string>().find("bravo is down"), std::string::npos)
+      << warned.dump();
+  stopAll(fleet, {"alpha"});
 }

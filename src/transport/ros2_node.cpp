@@ -1,4 +1,4 @@
-#include "tf_static.hpp"
+#include "ros2_node.hpp"
 
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
@@ -11,22 +11,36 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <stdexcept>
 
-#include "ros2_tfPubSubTypes.h"
+#include "ros2_msgsPubSubTypes.h"
 
 namespace tomomap::transport {
 
 using namespace eprosima::fastdds::dds;
 namespace ros_tf = tf2_msgs::msg::dds_;
 namespace ros_geometry = geometry_msgs::msg::dds_;
+namespace ros_diagnostic = diagnostic_msgs::msg::dds_;
 
 /// ROS 2's names: topic "rt/" + the ROS topic name.
 constexpr const char* kTfStaticTopic = "rt/tf_static";
+constexpr const char* kDiagnosticsTopic = "rt/diagnostics";
 
 Eigen::Vector4d yawQuaternion(double yaw) { return {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)}; }
 
-struct TfStaticPublisher::Impl {
+struct Ros2Node::Impl {
   DomainParticipant* participant = nullptr;
-  DataWriter* writer = nullptr;
+  Publisher* publisher = nullptr;
+  DataWriter* tf_static = nullptr;
+  DataWriter* diagnostics = nullptr;
+
+  /// A writer of `type` on `topic`.
+  DataWriter* writer(TypeSupport type, const char* topic, const DataWriterQos& qos) {
+    if (type.register_type(participant) != ReturnCode_t::RETCODE_OK)
+      throw std::runtime_error("cannot register " + type.get_type_name());
+    Topic* t = participant->create_topic(topic, type.get_type_name(), TOPIC_QOS_DEFAULT);
+    DataWriter* w = t ? publisher->create_datawriter(t, qos) : nullptr;
+    if (!w) throw std::runtime_error(std::string("cannot create the writer of ") + topic);
+    return w;
+  }
 
   ~Impl() {
     if (participant) {
@@ -81,34 +95,34 @@ void configureDiscovery(DomainParticipantQos& q, int ros_domain, bool localhost_
 
 }  // namespace
 
-TfStaticPublisher::TfStaticPublisher(int ros_domain, bool localhost_only) : impl_(std::make_unique<Impl>()) {
+Ros2Node::Ros2Node(int ros_domain, bool localhost_only) : impl_(std::make_unique<Impl>()) {
   DomainParticipantQos q;
-  q.name("tomomapd_tf");
+  q.name("tomomapd");
   configureDiscovery(q, ros_domain, localhost_only);
   auto& i = *impl_;
   i.participant = DomainParticipantFactory::get_instance()->create_participant(ros_domain, q);
   if (!i.participant)
     throw std::runtime_error("cannot create the ROS 2 participant on domain " + std::to_string(ros_domain));
-  TypeSupport type(new ros_tf::TFMessage_PubSubType());
-  if (type.register_type(i.participant) != ReturnCode_t::RETCODE_OK)
-    throw std::runtime_error("cannot register " + type.get_type_name());
-  Topic* topic = i.participant->create_topic(kTfStaticTopic, type.get_type_name(), TOPIC_QOS_DEFAULT);
-  Publisher* publisher = i.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
-  if (!topic || !publisher) throw std::runtime_error(std::string("cannot create ") + kTfStaticTopic);
+  i.publisher = i.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
+  if (!i.publisher) throw std::runtime_error("cannot create the ROS 2 publisher");
   // tf2_ros::StaticTransformBroadcaster's QoS: depth 1, reliable, transient local.
-  DataWriterQos wq = DATAWRITER_QOS_DEFAULT;
-  wq.reliability().kind = RELIABLE_RELIABILITY_QOS;
-  wq.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
-  wq.history().kind = KEEP_LAST_HISTORY_QOS;
-  wq.history().depth = 1;
-  wq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
-  i.writer = publisher->create_datawriter(topic, wq);
-  if (!i.writer) throw std::runtime_error(std::string("cannot create the writer of ") + kTfStaticTopic);
+  DataWriterQos tf = DATAWRITER_QOS_DEFAULT;
+  tf.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  tf.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
+  tf.history().kind = KEEP_LAST_HISTORY_QOS;
+  tf.history().depth = 1;
+  tf.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+  i.tf_static = i.writer(TypeSupport(new ros_tf::TFMessage_PubSubType()), kTfStaticTopic, tf);
+  // diagnostic_updater's: reliable, volatile, keep last 1 (a late reader waits for the next).
+  DataWriterQos diagnostics = tf;
+  diagnostics.durability().kind = VOLATILE_DURABILITY_QOS;
+  i.diagnostics =
+      i.writer(TypeSupport(new ros_diagnostic::DiagnosticArray_PubSubType()), kDiagnosticsTopic, diagnostics);
 }
 
-TfStaticPublisher::~TfStaticPublisher() = default;
+Ros2Node::~Ros2Node() = default;
 
-void TfStaticPublisher::publish(const std::vector<TfFrame>& frames) {
+void Ros2Node::publishTfStatic(const std::vector<TfFrame>& frames) {
   ros_tf::TFMessage_ msg;
   for (const auto& f : frames) {
     ros_geometry::TransformStamped_ t;
@@ -126,7 +140,28 @@ void TfStaticPublisher::publish(const std::vector<TfFrame>& frames) {
     t.transform().rotation().w(r[3]);
     msg.transforms().push_back(std::move(t));
   }
-  impl_->writer->write(&msg);
+  impl_->tf_static->write(&msg);
+}
+
+void Ros2Node::publishDiagnostics(const std::vector<Diagnostic>& statuses, uint64_t stamp_ms) {
+  ros_diagnostic::DiagnosticArray_ msg;
+  msg.header().stamp().sec(static_cast<int32_t>(stamp_ms / 1000));
+  msg.header().stamp().nanosec(static_cast<uint32_t>(stamp_ms % 1000) * 1000000u);
+  for (const auto& d : statuses) {
+    ros_diagnostic::DiagnosticStatus_ s;
+    s.level(static_cast<uint8_t>(d.level));
+    s.name(d.name);
+    s.message(d.message);
+    s.hardware_id(d.hardware_id);
+    for (const auto& [key, value] : d.values) {
+      ros_diagnostic::KeyValue_ kv;
+      kv.key(key);
+      kv.value(value);
+      s.values().push_back(std::move(kv));
+    }
+    msg.status().push_back(std::move(s));
+  }
+  impl_->diagnostics->write(&msg);
 }
 
 }  // namespace tomomap::transport

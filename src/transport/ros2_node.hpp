@@ -1,0 +1,56 @@
+#pragma once
+// The daemon's node on the ROS 2 domain, a DDS participant of its own: the
+// fleet's frames on /tf_static, published the way tf2_ros's static transform
+// broadcaster does (rt/tf_static, tf2_msgs::msg::dds_::TFMessage_, reliable,
+// transient local, the whole tree in the last sample), and the daemon's health
+// on /diagnostics as diagnostic_updater publishes it (rt/diagnostics,
+// diagnostic_msgs::msg::dds_::DiagnosticArray_, reliable, volatile). ROS 2
+// nodes see both with no ROS 2 dependency here (docs/operations.md, "ROS 2").
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace tomomap::transport {
+
+struct TfFrame {
+  std::string parent, child;  ///< frame ids
+  Pose4 T_parent_child;       ///< the child frame's pose in the parent frame
+  uint64_t stamp_ms = 0;      ///< [ms since the epoch]
+};
+
+/// The ROS 2 message's quaternion (x, y, z, w) for a rotation by `yaw` about z.
+Eigen::Vector4d yawQuaternion(double yaw);
+
+/// One diagnostic_msgs/DiagnosticStatus.
+struct Diagnostic {
+  enum Level : uint8_t { ok = 0, warn = 1, error = 2, stale = 3 };
+  Level level = ok;
+  std::string name, message, hardware_id;
+  std::vector<std::pair<std::string, std::string>> values;  ///< key, value
+};
+
+class Ros2Node {
+ public:
+  /// `localhost_only`: the participant reaches ROS 2 nodes on this host only,
+  /// under any of ROS 2's local discovery settings, and nothing of it reaches
+  /// the robots' thin link; otherwise the network's nodes too, by multicast
+  /// (ros2_node.cpp, configureDiscovery). Throws std::runtime_error if DDS refuses.
+  Ros2Node(int ros_domain, bool localhost_only);
+  ~Ros2Node();
+  Ros2Node(const Ros2Node&) = delete;
+  Ros2Node& operator=(const Ros2Node&) = delete;
+
+  /// Replaces what /tf_static holds with `frames` (all of them, one sample).
+  void publishTfStatic(const std::vector<TfFrame>& frames);
+  /// One DiagnosticArray on /diagnostics, stamped `stamp_ms` [ms since the epoch].
+  void publishDiagnostics(const std::vector<Diagnostic>& statuses, uint64_t stamp_ms);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tomomap::transport
