@@ -2,6 +2,7 @@
 
 #include "core/text.hpp"
 #include "io/map_io.hpp"
+#include "io/point_cloud2.hpp"
 #include "transport/estimate_wire.hpp"
 
 namespace tomomap::daemon {
@@ -27,21 +28,28 @@ void Agent::post(std::function<void()> work) {
 namespace {
 
 std::string tiltText(const MapFeatures& f) {
-  return f.tilt.measured ? "tilt " + fixed(degrees(f.tilt.angle), 1) + " +- " + fixed(degrees(f.tilt.uncertainty), 1) + " deg"
-                         : "tilt not measurable (too few flat surfaces)";
+  return f.tilt.measured
+             ? "tilt " + fixed(degrees(f.tilt.angle), 1) + " +- " + fixed(degrees(f.tilt.uncertainty), 1) + " deg"
+             : "tilt not measurable (too few flat surfaces)";
 }
 
 }  // namespace
 
-OwnMap describeOwnMap(const Config& config) {
+std::string mapSource(const Config& config) {
+  return config.ros2.map_topic.empty() ? config.map : "ROS 2 topic " + config.ros2.map_topic;
+}
+
+namespace {
+
+/// Describes and encodes the map `load` reads into `own`'s counts.
+OwnMap describeLoaded(const Config& config, OwnMap own, const std::function<Points(OwnMap&)>& load) {
   const auto t0 = Clock::now();
-  OwnMap own;
   auto features = [&] {
-    const Points map = loadMap(config.map, &own.nonfinite, &own.note);  // dropped once described
+    const Points map = load(own);  // dropped once described
     return std::make_shared<MapFeatures>(describeMap(map, config.match, nullptr, &own.cells));
   }();
   // Peers would match slanted slices: offered nowhere, refused here.
-  if (const auto why = tiltRefusal(*features, "own", config.match)) throw InputError(config.map + ": " + *why);
+  if (const auto why = tiltRefusal(*features, "own", config.match)) throw InputError(mapSource(config) + ": " + *why);
   own.offer = transport::makeOffer(
       config.agent(), *features, config.match.features, binaryPcdBytes(own.cells),
       transport::maxSampleBytes(config.transport.bandwidth_kbps, config.transport.security.enabled()));
@@ -50,14 +58,33 @@ OwnMap describeOwnMap(const Config& config) {
   return own;
 }
 
+}  // namespace
+
+OwnMap describeOwnMap(const Config& config) {
+  return describeLoaded(config, {}, [&](OwnMap& own) { return loadMap(config.map, &own.nonfinite, &own.note); });
+}
+
+OwnMap describeOwnMap(const Config& config, const transport::CloudMessage& cloud) {
+  OwnMap own;
+  own.frame_id = cloud.frame_id;
+  return describeLoaded(config, std::move(own), [&](OwnMap& o) {
+    try {
+      return pointsFromCloud2(cloud.layout, cloud.data.data(), cloud.data.size(), &o.nonfinite);
+    } catch (const InputError& e) {
+      throw InputError(mapSource(config) + ": " + e.what());
+    }
+  });
+}
+
 void Agent::installOwnMap(OwnMap own) {
   if (!own.note.empty()) log_.info(own.note);
+  const std::string source = mapSource(config_);
   if (own.nonfinite > 0)
-    log_.warning(config_.map + ": dropped " + std::to_string(own.nonfinite) +
-                 " points with NaN or infinite coordinates");
+    log_.warning(source + ": dropped " + std::to_string(own.nonfinite) + " points with NaN or infinite coordinates");
   if (own.features->occupancy.stray > 0)
-    log_.warning(config_.map + ": left out " + std::to_string(own.features->occupancy.stray) +
+    log_.warning(source + ": left out " + std::to_string(own.features->occupancy.stray) +
                  " stray voxels far from the rest of the map");
+  map_frame_id_ = own.frame_id;
   const bool update = own_features_ != nullptr;
   const uint64_t before = sender_.version();
   sender_.setOffer(std::move(own.offer));
@@ -70,9 +97,10 @@ void Agent::installOwnMap(OwnMap own) {
     as_cells += samples.front().encoding() == wire::SliceEncoding::OCCUPANCY;
   const auto& a = offer.announcement;
   log_.info(
-      std::string(update ? "map updated: " : "map ") + config_.map + ": " + std::to_string(own.cells) + " cells at g " +
-      fixed(config_.match.grid, 3) + " m, " + std::to_string(a.slices().size()) + " descriptive slices (" +
-      std::to_string(as_cells) + " sent as occupancy, the rest as features), " +
+      std::string(update ? "map updated: " : "map ") + source +
+      (own.frame_id.empty() ? "" : " (frame " + own.frame_id + ")") + ": " + std::to_string(own.cells) +
+      " cells at g " + fixed(config_.match.grid, 3) + " m, " + std::to_string(a.slices().size()) +
+      " descriptive slices (" + std::to_string(as_cells) + " sent as occupancy, the rest as features), " +
       std::to_string(own_features_->featureCount()) + " features; version " + versionText(a.version()) +
       (update ? " (was " + versionText(before) + ")" : "") + "; payload " + std::to_string(offer.payload_bytes) +
       " bytes = " + fixed(100.0 * static_cast<double>(offer.payload_bytes) / static_cast<double>(a.raw_bytes()), 1) +

@@ -42,11 +42,17 @@ struct OwnMap {
   size_t nonfinite = 0;  ///< points with NaN or infinite coordinates, dropped
   std::string note;      ///< how the file was read, when a user should know (loadMap)
   double seconds = 0;    ///< time taken to describe it
+  std::string frame_id;  ///< the map message's frame (map from a topic); empty for a file
 };
 
-/// Loads, describes and encodes the map the config names. Throws InputError
-/// for an unreadable map. Pure work: safe to run on any thread.
+/// Where the config says the map comes from: its file, or "ROS 2 topic X".
+std::string mapSource(const Config& config);
+
+/// Loads, describes and encodes the map the config names (its file). Throws
+/// InputError for an unreadable map. Pure work: safe to run on any thread.
 OwnMap describeOwnMap(const Config& config);
+/// The same for a map that arrived on the [ros2] map_topic.
+OwnMap describeOwnMap(const Config& config, const transport::CloudMessage& cloud);
 
 /// The claim timings the config sets.
 inline BoardTimings boardTimings(const Config& c) {
@@ -134,6 +140,10 @@ class Agent {
   std::unique_ptr<transport::Ros2Node> ros2_;
   std::optional<std::vector<TreeEdge>> tf_published_;  ///< what /tf_static holds; none before the first sample
   std::optional<Clock::time_point> diagnostics_published_;
+  /// The latest map message from [ros2] map_topic not yet described; one at a
+  /// time: a SLAM package may publish its map with every scan.
+  std::shared_ptr<const transport::CloudMessage> cloud_;
+  std::string map_frame_id_;  ///< the frame of the map offered, when it came from a topic
   transport::BusHandlers handlers_;
   Notifier notifier_;
   std::unique_ptr<MapWatch> watch_;

@@ -45,7 +45,7 @@ void Agent::joinNetwork() {
 }
 
 std::string Agent::waitingText() const {
-  return "waiting for map " + config_.map + (map_refused_.empty() ? "" : " (its content: " + map_refused_ + ")");
+  return "waiting for map " + mapSource(config_) + (map_refused_.empty() ? "" : " (its content: " + map_refused_ + ")");
 }
 
 void Agent::followMapFile() {
@@ -56,22 +56,31 @@ void Agent::followMapFile() {
       OwnMap own = describing_.get();
       map_refused_.clear();
       if (own.offer.announcement.version() == sender_.version())
-        log_.info("map file rewritten with the same content: version " + versionText(sender_.version()) + " stays");
+        log_.info("map " + std::string(config_.ros2.map_topic.empty() ? "file rewritten" : "published again") +
+                  " with the same content: version " + versionText(sender_.version()) + " stays");
       else
         installOwnMap(std::move(own));
     } catch (const std::exception& e) {
       // Typically a file caught half-written: its next write brings us back.
       map_refused_ = e.what();
-      log_.warning(std::string("map file changed but cannot be used (") + e.what() + "); " +
+      log_.warning(std::string("map changed but cannot be used (") + e.what() + "); " +
                    (offering() ? "still offering version " + versionText(sender_.version()) : "offering no map yet"));
     }
     return;
   }
   if (!map_touched_ || Clock::now() - *map_touched_ < kMapSettle) return;
   map_touched_.reset();
-  log_.info("map file changed: describing it again");
   // On a helper thread: the loop keeps serving peers. It gets a copy of the
-  // config and nothing of the agent's state.
+  // config (and of the message) and nothing of the agent's state.
+  if (!config_.ros2.map_topic.empty()) {
+    if (!cloud_) return;
+    log_.info("map message on " + config_.ros2.map_topic + " (" + std::to_string(cloud_->data.size()) +
+              " bytes): describing it");
+    describing_ = std::async(std::launch::async,
+                             [config = config_, cloud = std::move(cloud_)] { return describeOwnMap(config, *cloud); });
+    return;
+  }
+  log_.info("map file changed: describing it again");
   describing_ = std::async(std::launch::async, [config = config_] { return describeOwnMap(config); });
 }
 
@@ -122,7 +131,7 @@ void Agent::reload() {
     }
   }
   if (ros2_changed) startRos2();
-  watch_ = std::make_unique<MapWatch>(config_.map);
+  watch_ = config_.ros2.map_topic.empty() ? std::make_unique<MapWatch>(config_.map) : nullptr;
   map_touched_ = Clock::now() - kMapSettle;  // and read the map again now
   persist(true);
   notifier_.ready();
@@ -162,7 +171,9 @@ int Agent::run(Signals& signals) {
   // At boot the map may not be written yet: the agent joins and waits for it
   // (the folder is watched below). A map that exists but cannot be used is a
   // mistake to fix, not to wait out.
-  if (fs::exists(config_.map)) {
+  if (!config_.ros2.map_topic.empty()) {
+    log_.info("the map comes from ROS 2 topic " + config_.ros2.map_topic + ": matching starts with its first message");
+  } else if (fs::exists(config_.map)) {
     try {
       installOwnMap(describeOwnMap(config_));
     } catch (const InputError& e) {
@@ -198,9 +209,13 @@ int Agent::run(Signals& signals) {
     return 2;
   }
   startRos2();
+  if (!config_.ros2.map_topic.empty() && !ros2_) {
+    log_.error("cannot read the map from ROS 2 topic " + config_.ros2.map_topic + " without a ROS 2 node");
+    return 2;
+  }
   persist(true);
-  watch_ = std::make_unique<MapWatch>(config_.map);
-  if (!watch_->active())
+  if (config_.ros2.map_topic.empty()) watch_ = std::make_unique<MapWatch>(config_.map);
+  if (watch_ && !watch_->active())
     log_.warning("cannot watch the folder of " + config_.map + " for changes: send SIGHUP after updating the map");
   // The log line first: whoever acts on READY=1 (a test, an operator) finds it.
   const std::string peers = std::to_string(config_.transport.peers.size()) + " peers";

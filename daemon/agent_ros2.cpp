@@ -32,6 +32,19 @@ void Agent::startRos2() {
   if (!config_.ros2.enabled) return;
   try {
     ros2_ = std::make_unique<transport::Ros2Node>(config_.ros2.domain, config_.ros2.localhost_only);
+    if (!config_.ros2.map_topic.empty()) {
+      // Each message is whole (unlike a file being written), but a SLAM
+      // package may publish one with every scan: the newest is described once
+      // the last description is done and the first message waiting for it
+      // has waited kMapSettle (agent_lifecycle.cpp).
+      ros2_->subscribeMap(config_.ros2.map_topic, [this](transport::CloudMessage&& m) {
+        post([this, m = std::make_shared<const transport::CloudMessage>(std::move(m))] {
+          cloud_ = m;
+          if (!map_touched_) map_touched_ = Clock::now();
+        });
+      });
+      log_.info("ROS 2: reading this robot's map from " + config_.ros2.map_topic + " (sensor_msgs/PointCloud2)");
+    }
     log_.info("ROS 2: publishing the fleet's frames on /tf_static and this daemon's health on /diagnostics (domain " +
               std::to_string(config_.ros2.domain) + ", root frame " + config_.ros2.frameOf(config_.treeRoot()) + ")");
   } catch (const std::exception& e) {

@@ -2,6 +2,7 @@
 
 #include <toml++/toml.h>
 
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -59,7 +60,8 @@ const std::vector<std::string> kKeys{"agent",
                                      "ros2.domain",
                                      "ros2.frame",
                                      "ros2.root",
-                                     "ros2.localhost_only"};
+                                     "ros2.localhost_only",
+                                     "ros2.map_topic"};
 
 struct Reader {
   std::string file;
@@ -157,6 +159,25 @@ void readMatch(const Reader& r, const toml::table& root, MatchParams& m) {
 }
 
 /// The [ros2] table: present means on, unless it says `enabled = false`.
+/// A ROS 2 topic name: segments of letters, digits and _, not starting with a
+/// digit, separated by / (a leading / or none: relative names resolve to the root).
+bool validRosTopic(const std::string& name) {
+  std::string rest = name.rfind('/', 0) == 0 ? name.substr(1) : name;
+  if (rest.empty() || rest.back() == '/') return false;
+  bool segment_start = true;
+  for (char ch : rest) {
+    if (ch == '/') {
+      if (segment_start) return false;  // an empty segment
+      segment_start = true;
+      continue;
+    }
+    if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_')) return false;
+    if (segment_start && std::isdigit(static_cast<unsigned char>(ch))) return false;
+    segment_start = false;
+  }
+  return true;
+}
+
 void readRos2(const Reader& r, const toml::table& root, Config& c) {
   const toml::table* t = knownTable(r, root, "ros2");
   if (!t) return;
@@ -170,6 +191,15 @@ void readRos2(const Reader& r, const toml::table& root, Config& c) {
   if (!ros.root.empty() && !c.inFleet(ros.root))
     r.fail(*t->get("root"), "ros2.root", "'" + ros.root + "' is neither this agent nor one of its peers");
   ros.localhost_only = r.flag(*t, "localhost_only", ros.localhost_only);
+  ros.map_topic = r.text(*t, "map_topic", std::string());
+  if (!ros.map_topic.empty()) {
+    if (!ros.enabled) r.fail(*t->get("map_topic"), "ros2.map_topic", "needs [ros2] enabled");
+    if (!c.map.empty())
+      r.fail(*t->get("map_topic"), "ros2.map_topic", "the map comes from one place: remove `map` or `map_topic`");
+    if (!validRosTopic(ros.map_topic))
+      r.fail(*t->get("map_topic"), "ros2.map_topic",
+             "'" + ros.map_topic + "' is not a ROS 2 topic name (letters, digits, _ and / only, e.g. /Laser_map)");
+  }
 }
 
 /// The [security] table: DDS Security's files, each of which must exist
@@ -263,7 +293,8 @@ Config loadConfig(const std::string& path) {
   c.file = fs::absolute(path).lexically_normal().string();
   auto& t = c.transport;
   t.agent = checkedId(r, root, "agent");
-  c.map = resolve(r.text(root, "map", std::nullopt));
+  // Required unless [ros2] map_topic brings the map (checked after it).
+  if (root.get("map")) c.map = resolve(r.text(root, "map", std::nullopt));
   c.match.grid = r.number(root, "grid", c.match.grid, 0.005, 10);
   readMatch(r, root, c.match);
   t.domain = static_cast<int>(r.number(root, "domain", 0, 0, 232));
@@ -318,6 +349,7 @@ Config loadConfig(const std::string& path) {
   if (!c.reference.empty() && !c.inFleet(c.reference))
     r.fail(*root.get("reference"), "reference", "'" + c.reference + "' is neither this agent nor one of its peers");
   readRos2(r, root, c);
+  if (c.map.empty() && c.ros2.map_topic.empty()) r.missing(root, "map");
   return c;
 }
 
@@ -353,7 +385,8 @@ std::string describe(const Config& c) {
   if (c.ros2.enabled)
     o << "\n  ros2.domain = " << c.ros2.domain << "\n  ros2.frame = " << c.ros2.frame
       << "\n  ros2.root = " << c.treeRoot()
-      << "\n  ros2.localhost_only = " << (c.ros2.localhost_only ? "true" : "false");
+      << "\n  ros2.localhost_only = " << (c.ros2.localhost_only ? "true" : "false")
+      << "\n  ros2.map_topic = " << (c.ros2.map_topic.empty() ? "(none: the map file)" : c.ros2.map_topic);
   else
     o << "\n  ros2: off (no [ros2] table)";
   for (const auto& p : t.peers) o << "\n  peer " << p.id << " = " << p.host << ":" << p.port;

@@ -17,18 +17,21 @@ struct Ros2Config {
   std::string frame = "{agent}/map";  ///< frame id of each agent's map; {agent} is replaced by its id
   std::string root;                   ///< the tree's root agent; empty: the lowest id in the fleet
   bool localhost_only = true;         ///< reach ROS 2 nodes on this robot only, never the robots' link
+  /// A sensor_msgs/PointCloud2 topic that carries this robot's map (its SLAM's
+  /// map cloud), instead of the `map` file; empty: the file.
+  std::string map_topic;
 
   std::string frameOf(const std::string& agent) const;
   bool operator==(const Ros2Config& o) const {
     return enabled == o.enabled && domain == o.domain && frame == o.frame && root == o.root &&
-           localhost_only == o.localhost_only;
+           localhost_only == o.localhost_only && map_topic == o.map_topic;
   }
 };
 
 struct Config {
   std::string file;                      ///< where it was read from
   transport::TransportConfig transport;  ///< agent id, domain, address, ports, peers, bandwidth
-  std::string map;                       ///< own map file (absolute, or relative to the config file)
+  std::string map;  ///< own map file (absolute, or relative to the config file); empty with ros2.map_topic
   /// `grid` and the [match] table; the defaults are MatchParams', but for
   /// levelling: the fleet's transforms are 4-DoF between the maps' own
   /// frames, and a levelled map's frame is not its own, so a map leaning
@@ -38,7 +41,7 @@ struct Config {
     m.level = false;
     return m;
   }();
-  std::string output_dir;                ///< transforms.json, status.json
+  std::string output_dir;  ///< transforms.json, status.json
   LogLevel log_level = LogLevel::Info;
   double claim_timeout_s = 30;    ///< a claim without a result is void after this [s]
   double request_interval_s = 1;  ///< ask again for missing slices after this much silence [s]

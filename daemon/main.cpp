@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   if (check) {
     std::cout << describe(config) << "\n";
     // Not an error: at boot the map may come later, and the daemon waits for it.
-    if (!std::filesystem::exists(config.map))
+    if (config.ros2.map_topic.empty() && !std::filesystem::exists(config.map))
       log.warning(config.map + " does not exist yet: tomomapd will wait for it");
     return 0;
   }

@@ -4,11 +4,17 @@
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
 
+#include <deque>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <mutex>
 #include <stdexcept>
 
 #include "ros2_msgsPubSubTypes.h"
@@ -19,6 +25,7 @@ using namespace eprosima::fastdds::dds;
 namespace ros_tf = tf2_msgs::msg::dds_;
 namespace ros_geometry = geometry_msgs::msg::dds_;
 namespace ros_diagnostic = diagnostic_msgs::msg::dds_;
+namespace ros_sensor = sensor_msgs::msg::dds_;
 
 /// ROS 2's names: topic "rt/" + the ROS topic name.
 constexpr const char* kTfStaticTopic = "rt/tf_static";
@@ -26,11 +33,54 @@ constexpr const char* kDiagnosticsTopic = "rt/diagnostics";
 
 Eigen::Vector4d yawQuaternion(double yaw) { return {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)}; }
 
+/// Takes the map messages of both readers of the map topic (transient local
+/// and volatile: each matches writers the other cannot) and hands each on once.
+class MapListener : public DataReaderListener {
+ public:
+  explicit MapListener(std::function<void(CloudMessage&&)> on_message) : on_message_(std::move(on_message)) {}
+
+  void on_data_available(DataReader* reader) override {
+    ros_sensor::PointCloud2_ msg;
+    SampleInfo info;
+    while (reader->take_next_sample(&msg, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || seenBefore(info.sample_identity)) continue;
+      CloudMessage m;
+      m.layout.height = msg.height();
+      m.layout.width = msg.width();
+      m.layout.is_bigendian = msg.is_bigendian();
+      m.layout.point_step = msg.point_step();
+      m.layout.row_step = msg.row_step();
+      for (const auto& f : msg.fields()) m.layout.fields.push_back({f.name(), f.offset(), f.datatype(), f.count()});
+      m.data = std::move(msg.data());
+      m.frame_id = msg.header().frame_id();
+      m.stamp_ms = static_cast<uint64_t>(msg.header().stamp().sec()) * 1000 + msg.header().stamp().nanosec() / 1000000;
+      on_message_(std::move(m));
+    }
+  }
+
+ private:
+  /// Whether the other reader already took this sample (a transient local
+  /// writer's samples reach both).
+  bool seenBefore(const eprosima::fastrtps::rtps::SampleIdentity& id) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& s : seen_)
+      if (s == id) return true;
+    seen_.push_back(id);
+    if (seen_.size() > 16) seen_.pop_front();
+    return false;
+  }
+
+  std::function<void(CloudMessage&&)> on_message_;
+  std::mutex mutex_;
+  std::deque<eprosima::fastrtps::rtps::SampleIdentity> seen_;
+};
+
 struct Ros2Node::Impl {
   DomainParticipant* participant = nullptr;
   Publisher* publisher = nullptr;
   DataWriter* tf_static = nullptr;
   DataWriter* diagnostics = nullptr;
+  std::unique_ptr<MapListener> map_listener;
 
   /// A writer of `type` on `topic`.
   DataWriter* writer(TypeSupport type, const char* topic, const DataWriterQos& qos) {
@@ -44,6 +94,7 @@ struct Ros2Node::Impl {
 
   ~Impl() {
     if (participant) {
+      // The readers go (and their listener stops being called) before the listener does.
       participant->delete_contained_entities();
       DomainParticipantFactory::get_instance()->delete_participant(participant);
     }
@@ -162,6 +213,34 @@ void Ros2Node::publishDiagnostics(const std::vector<Diagnostic>& statuses, uint6
     msg.status().push_back(std::move(s));
   }
   impl_->diagnostics->write(&msg);
+}
+
+}  // namespace tomomap::transport
+
+namespace tomomap::transport {
+
+void Ros2Node::subscribeMap(const std::string& topic, std::function<void(CloudMessage&&)> on_message) {
+  auto& i = *impl_;
+  TypeSupport type(new ros_sensor::PointCloud2_PubSubType());
+  if (type.register_type(i.participant) != ReturnCode_t::RETCODE_OK)
+    throw std::runtime_error("cannot register " + type.get_type_name());
+  // ROS 2's names: "rt" + the topic's absolute name.
+  const std::string dds_topic = "rt" + (topic.rfind('/', 0) == 0 ? topic : "/" + topic);
+  Topic* t = i.participant->create_topic(dds_topic, type.get_type_name(), TOPIC_QOS_DEFAULT);
+  Subscriber* subscriber = t ? i.participant->create_subscriber(SUBSCRIBER_QOS_DEFAULT) : nullptr;
+  if (!subscriber) throw std::runtime_error("cannot subscribe to " + topic);
+  i.map_listener = std::make_unique<MapListener>(std::move(on_message));
+  for (const DurabilityQosPolicyKind durability : {TRANSIENT_LOCAL_DURABILITY_QOS, VOLATILE_DURABILITY_QOS}) {
+    DataReaderQos q = DATAREADER_QOS_DEFAULT;
+    q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+    q.durability().kind = durability;
+    q.history().kind = KEEP_LAST_HISTORY_QOS;
+    q.history().depth = 1;
+    // Maps of tens of MB: memory the size of each sample, not of the largest.
+    q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+    if (!subscriber->create_datareader(t, q, i.map_listener.get()))
+      throw std::runtime_error("cannot create the reader of " + topic);
+  }
 }
 
 }  // namespace tomomap::transport

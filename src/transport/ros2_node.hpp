@@ -6,12 +6,14 @@
 // on /diagnostics as diagnostic_updater publishes it (rt/diagnostics,
 // diagnostic_msgs::msg::dds_::DiagnosticArray_, reliable, volatile). ROS 2
 // nodes see both with no ROS 2 dependency here (docs/operations.md, "ROS 2").
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "core/types.hpp"
+#include "io/point_cloud2.hpp"
 
 namespace tomomap::transport {
 
@@ -32,6 +34,15 @@ struct Diagnostic {
   std::vector<std::pair<std::string, std::string>> values;  ///< key, value
 };
 
+/// One sensor_msgs/PointCloud2 as it arrived, undecoded (io/point_cloud2.hpp
+/// reads it): decoding a large map is left to whoever has time for it.
+struct CloudMessage {
+  PointCloud2Layout layout;
+  std::vector<uint8_t> data;
+  std::string frame_id;
+  uint64_t stamp_ms = 0;  ///< the header's stamp [ms since the epoch]
+};
+
 class Ros2Node {
  public:
   /// `localhost_only`: the participant reaches ROS 2 nodes on this host only,
@@ -47,6 +58,12 @@ class Ros2Node {
   void publishTfStatic(const std::vector<TfFrame>& frames);
   /// One DiagnosticArray on /diagnostics, stamped `stamp_ms` [ms since the epoch].
   void publishDiagnostics(const std::vector<Diagnostic>& statuses, uint64_t stamp_ms);
+  /// Reads sensor_msgs/PointCloud2 from the ROS 2 topic `topic` (e.g.
+  /// /Laser_map) with the QoS SLAM packages publish maps with: reliable, keep
+  /// last 1, volatile or transient local (a latched map that was published
+  /// before this node started arrives too). Each new message goes to
+  /// `on_message`, on a DDS thread. Throws std::runtime_error if DDS refuses.
+  void subscribeMap(const std::string& topic, std::function<void(CloudMessage&&)> on_message);
 
  private:
   struct Impl;

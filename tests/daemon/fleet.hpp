@@ -51,9 +51,10 @@ class Fleet {
   /// Writes the config of `spec`; `everyone` lists the fleet (for ports).
   std::string writeConfig(const AgentSpec& spec, const std::vector<AgentSpec>& everyone) {
     std::ostringstream c;
-    c << "agent = \"" << spec.id << "\"\nmap = \"" << spec.map << "\"\ngrid = " << spec.grid
-      << "\ndiscovery_port = " << port(indexOf(spec.id, everyone)) << "\nbandwidth_kbps = " << spec.bandwidth_kbps
-      << "\noutput_dir = \"" << (dir_ / ("out-" + spec.id))
+    c << "agent = \"" << spec.id << "\"\n";
+    if (!spec.map.empty()) c << "map = \"" << spec.map << "\"\n";  // none: a map from a ROS 2 topic
+    c << "grid = " << spec.grid << "\ndiscovery_port = " << port(indexOf(spec.id, everyone))
+      << "\nbandwidth_kbps = " << spec.bandwidth_kbps << "\noutput_dir = \"" << (dir_ / ("out-" + spec.id))
       << "\"\nrequest_interval_s = 1\nclaim_timeout_s = " << claim_timeout_s << "\n"
       << spec.extra;
     for (const auto& other : everyone) {

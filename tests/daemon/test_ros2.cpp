@@ -7,16 +7,19 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fstream>
 #include <map>
 #include <sstream>
 
 #include "fleet.hpp"
+#include "io/map_io.hpp"
 #include "ros2_msgsPubSubTypes.h"
 
 using namespace tomomap;
@@ -266,4 +269,93 @@ TEST(Ros2, ACycloneDdsNodeReadsTfStaticUnderEachDiscoverySettingAndDiagnostics) 
   EXPECT_NE(warned["status"][0]["message"].get<std::string>().find("bravo is down"), std::string::npos)
       << warned.dump();
   stopAll(fleet, {"alpha"});
+}
+
+namespace {
+
+/// `points` as float32 x, y, z triples in `path`, for cyclone_cloud_publisher.
+void writeRawPoints(const std::string& path, const Points& points) {
+  std::ofstream out(path, std::ios::binary);
+  for (const auto& p : points) out.write(reinterpret_cast<const char*>(p.data()), 3 * sizeof(float));
+}
+
+/// Publishes the points in `raw` on `topic` from a Cyclone DDS node kept on
+/// this host (Jazzy's LOCALHOST range), as a SLAM package publishes its map;
+/// returns once the daemon's readers acknowledged it.
+CommandResult publishCloud(int domain, const std::string& topic, const std::string& raw, const char* layout) {
+  return runBinary("env", "CYCLONEDDS_URI='" + kJazzyLocalhost.cyclonedds_uri + "' " CYCLONE_CLOUD_PUBLISHER_BIN " " +
+                              std::to_string(domain) + " " + topic + " " + raw + " " + layout + " bravo_odom 120");
+}
+
+}  // namespace
+
+// A robot whose SLAM publishes its map as sensor_msgs/PointCloud2 (as
+// LIO-SAM, FAST-LIO, RTAB-Map do) needs no file: bravo's daemon reads the
+// topic, published by a Cyclone DDS node with ROS 2's types, agrees with
+// alpha, which reads a file, and after a second message (another layout,
+// float64 in two padded rows) agrees again, sending only changed slices.
+TEST(Ros2, AMapFromAPointCloud2TopicIsAgreedAndUpdatedLikeAMapFile) {
+  REQUIRE_DEMO_ROOM();
+  TempDir dir;
+  const std::string d = demoRoom() + "/";
+  const int domain = 150 + static_cast<int>(::getpid() % 40);
+  const std::string topic = "/bravo/slam/map";
+  Fleet fleet(dir);
+  std::vector<AgentSpec> agents{{"alpha", d + "demo-pcd1.pcd"}, {"bravo", ""}};
+  agents[1].extra = "[ros2]\ndomain = " + std::to_string(domain) + "\nmap_topic = \"" + topic + "\"\n";
+  for (const auto& a : agents) fleet.start(a, agents);
+  ASSERT_TRUE(Fleet::waitFor([&] { return fleet.log("bravo").find("ready:") != std::string::npos; }, 60s))
+      << fleet.log("bravo");
+  EXPECT_NE(fleet.log("bravo").find("waiting for map ROS 2 topic " + topic), std::string::npos) << fleet.log("bravo");
+
+  const Points original = loadMap(d + "demo-pcd2.pcd");
+  writeRawPoints(dir / "v1.xyz32", original);
+  const auto first = publishCloud(domain, topic, dir / "v1.xyz32", "xyzi32");
+  ASSERT_EQ(first.exit_code, 0) << first.output << fleet.log("bravo");
+  ASSERT_TRUE(fleet.waitForTransforms({"alpha", "bravo"}, 1, 120s)) << fleet.log("alpha") << fleet.log("bravo");
+  const Pose4 gt = groundTruth(d + "demo-pcd1-gtpose.txt", d + "demo-pcd2-gtpose.txt");
+  const auto t1 = fleet.transforms("alpha").at("alpha<-bravo");
+  ASSERT_TRUE(t1["reliable"].get<bool>()) << t1.dump(2);
+  const PoseError e1 = poseError(poseOf(t1), gt);
+  EXPECT_LT(e1.translation, 0.05);
+  const auto status = fleet.readJson("bravo", "status.json");
+  EXPECT_EQ(status["map"]["path"], "ROS 2 topic " + topic);
+  EXPECT_EQ(status["map"]["frame_id"], "bravo_odom");
+  const std::string v1 = status["map"]["version"];
+  const size_t sent_first = status["sent"]["bytes"];
+
+  // The robot maps a cabinet; its SLAM publishes the map again.
+  writeRawPoints(dir / "v2.xyz32", withCabinet(original));
+  const auto second = publishCloud(domain, topic, dir / "v2.xyz32", "xyz64");
+  ASSERT_EQ(second.exit_code, 0) << second.output << fleet.log("bravo");
+  std::string v2;
+  ASSERT_TRUE(Fleet::waitFor(
+      [&] {
+        v2 = fleet.readJson("bravo", "status.json")["map"].value("version", "");
+        if (v2.empty() || v2 == v1) return false;
+        for (const char* id : {"alpha", "bravo"}) {
+          const auto t = fleet.transforms(id);
+          if (!t.count("alpha<-bravo") || t.at("alpha<-bravo")["source_version"] != v2) return false;
+        }
+        return true;
+      },
+      120s))
+      << fleet.log("alpha") << fleet.log("bravo");
+  const auto t2 = fleet.transforms("alpha").at("alpha<-bravo");
+  ASSERT_TRUE(t2["reliable"].get<bool>()) << t2.dump(2);
+  const PoseError e2 = poseError(poseOf(t2), gt);
+  EXPECT_LT(e2.translation, 0.05);
+  const auto s = fleet.readJson("alpha", "status.json");
+  const auto& transfers = s["peers"]["bravo"]["transfers"];
+  ASSERT_EQ(transfers.size(), 2u) << s.dump(2);
+  EXPECT_GT(transfers[1]["slices_reused"].get<int>(), 0);
+  EXPECT_LT(transfers[1]["bytes"].get<size_t>(), transfers[0]["bytes"].get<size_t>()) << transfers.dump(2);
+  const size_t sent_total = fleet.readJson("bravo", "status.json")["sent"]["bytes"];
+  std::printf(
+      "map from %s: first agreed %.4f m, %.5f rad from the truth; after the update %.4f m, %.5f rad; "
+      "first transfer %zu B (%d slices), then %zu B (%d of %d slices reused); bravo sent %zu then %zu B\n",
+      topic.c_str(), e1.translation, e1.yaw, e2.translation, e2.yaw, transfers[0]["bytes"].get<size_t>(),
+      transfers[0]["slices"].get<int>(), transfers[1]["bytes"].get<size_t>(), transfers[1]["slices_reused"].get<int>(),
+      transfers[1]["slices"].get<int>(), sent_first, sent_total - sent_first);
+  stopAll(fleet, {"alpha", "bravo"});
 }

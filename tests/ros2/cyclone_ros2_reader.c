@@ -49,11 +49,12 @@ static int take_tf(const void* sample, const char* wanted) {
     print_string(t->header.frame_id);
     printf(", \"child\": ");
     print_string(t->child_frame_id);
-    printf(", \"sec\": %d, \"nanosec\": %u, \"x\": %.17g, \"y\": %.17g, \"z\": %.17g, "
-           "\"qx\": %.17g, \"qy\": %.17g, \"qz\": %.17g, \"qw\": %.17g}",
-           t->header.stamp.sec, t->header.stamp.nanosec, t->transform.translation.x, t->transform.translation.y,
-           t->transform.translation.z, t->transform.rotation.x, t->transform.rotation.y, t->transform.rotation.z,
-           t->transform.rotation.w);
+    printf(
+        ", \"sec\": %d, \"nanosec\": %u, \"x\": %.17g, \"y\": %.17g, \"z\": %.17g, "
+        "\"qx\": %.17g, \"qy\": %.17g, \"qz\": %.17g, \"qw\": %.17g}",
+        t->header.stamp.sec, t->header.stamp.nanosec, t->transform.translation.x, t->transform.translation.y,
+        t->transform.translation.z, t->transform.rotation.x, t->transform.rotation.y, t->transform.rotation.z,
+        t->transform.rotation.w);
   }
   printf("]}\n");
   return m->transforms._length >= (uint32_t)atoi(wanted);

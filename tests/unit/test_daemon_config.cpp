@@ -116,6 +116,32 @@ TEST(DaemonConfig, TheRos2TableTurnsTfStaticOnWithFramesAndARootFromTheFleet) {
   EXPECT_NE(e.find("'enabled': must be true or false"), std::string::npos) << e;
 }
 
+TEST(DaemonConfig, AMapTopicReplacesTheMapFile) {
+  TempDir dir;
+  const std::string head = "agent = \"bravo\"\ndiscovery_port = 17500\n";
+  const std::string peers = "[[peer]]\nid = \"alpha\"\nhost = \"1.2.3.4\"\nport = 17600\n";
+  std::ofstream(dir / "c.toml") << head << peers << "[ros2]\nmap_topic = \"/Laser_map\"\n";
+  const Config c = loadConfig(dir / "c.toml");
+  EXPECT_EQ(c.ros2.map_topic, "/Laser_map");
+  EXPECT_TRUE(c.map.empty());
+  EXPECT_NE(describe(c).find("ros2.map_topic = /Laser_map"), std::string::npos) << describe(c);
+
+  std::string e = errorOf(dir, head + peers);
+  EXPECT_NE(e.find("key 'map' is required"), std::string::npos) << "neither a file nor a topic: " << e;
+  e = errorOf(dir, head + "map = \"a.pcd\"\n" + peers + "[ros2]\nmap_topic = \"/Laser_map\"\n");
+  EXPECT_NE(e.find("the map comes from one place"), std::string::npos) << e;
+  for (const char* bad : {"/laser map", "/2d/map", "//map", "/map/", ""}) {
+    e = errorOf(dir, head + peers + "[ros2]\nmap_topic = \"" + bad + "\"\n");
+    if (std::string(bad).empty()) {
+      EXPECT_NE(e.find("key 'map' is required"), std::string::npos) << "an empty topic is none: " << e;
+      continue;
+    }
+    EXPECT_NE(e.find("is not a ROS 2 topic name"), std::string::npos) << bad << ": " << e;
+  }
+  e = errorOf(dir, head + peers + "[ros2]\nenabled = false\nmap_topic = \"/map\"\n");
+  EXPECT_NE(e.find("needs [ros2] enabled"), std::string::npos) << e;
+}
+
 TEST(DaemonConfig, EveryKeyIsInTheReference) {
   std::ifstream in(std::string(TOMOMAP_SOURCE_DIR) + "/docs/configuration.md");
   const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
