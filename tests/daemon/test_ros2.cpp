@@ -3,6 +3,7 @@
 // QoS, as rclcpp's tf2 listener would.
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -17,6 +18,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 #include "fleet.hpp"
 #include "io/map_io.hpp"
@@ -29,17 +31,61 @@ using namespace eprosima::fastdds::dds;
 
 namespace {
 
-/// A /tf_static reader on `domain`, joined late (transient local brings it
-/// what was published before), on loopback and shared memory like the daemon.
+/// The ROS 2 discovery settings as rmw_fastrtps_cpp configures Fast DDS for them.
+enum class FastDdsRos2 {
+  humble_localhost_only,     ///< ROS_LOCALHOST_ONLY=1: UDP on loopback, and shared memory
+  jazzy_localhost,           ///< ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
+  jazzy_subnet_static_peer,  ///< SUBNET with ROS_STATIC_PEERS=127.0.0.1
+  defaults,                  ///< nothing set (Humble; Jazzy's SUBNET): Fast DDS's defaults
+};
+
+/// rmw_fastrtps_cpp's participant settings for `setting`.
+DomainParticipantQos fastDdsQos(FastDdsRos2 setting) {
+  using eprosima::fastrtps::rtps::IPLocator;
+  using eprosima::fastrtps::rtps::Locator_t;
+  DomainParticipantQos q;
+  Locator_t localhost, multicast;
+  IPLocator::setIPv4(localhost, 127, 0, 0, 1);
+  IPLocator::setIPv4(multicast, 239, 255, 0, 1);
+  auto& builtin = q.wire_protocol().builtin;
+  switch (setting) {
+    case FastDdsRos2::humble_localhost_only: {
+      q.transport().use_builtin_transports = false;
+      auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+      udp->interfaceWhiteList.emplace_back("127.0.0.1");
+      q.transport().user_transports.push_back(udp);
+      q.transport().user_transports.push_back(
+          std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+      break;
+    }
+    case FastDdsRos2::jazzy_localhost: {
+      builtin.metatrafficMulticastLocatorList.clear();
+      builtin.metatrafficUnicastLocatorList.push_back(Locator_t());
+      q.transport().use_builtin_transports = false;
+      q.transport().user_transports.push_back(
+          std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+      auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+      udp->maxInitialPeersRange = 32;
+      q.transport().user_transports.push_back(udp);
+      builtin.initialPeersList.push_back(localhost);
+      break;
+    }
+    case FastDdsRos2::jazzy_subnet_static_peer:
+      builtin.initialPeersList.push_back(localhost);
+      builtin.initialPeersList.push_back(multicast);
+      break;
+    case FastDdsRos2::defaults:
+      break;
+  }
+  return q;
+}
+
+/// A /tf_static reader on `domain` as a ROS 2 node with `setting` reads it,
+/// joined late (transient local brings it what was published before).
 class TfStaticReader {
  public:
-  explicit TfStaticReader(int domain) {
-    DomainParticipantQos q;
-    q.transport().use_builtin_transports = false;
-    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
-    udp->interfaceWhiteList.emplace_back("127.0.0.1");
-    q.transport().user_transports.push_back(udp);
-    q.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+  explicit TfStaticReader(int domain, FastDdsRos2 setting = FastDdsRos2::humble_localhost_only) {
+    const DomainParticipantQos q = fastDdsQos(setting);
     participant_ = DomainParticipantFactory::get_instance()->create_participant(domain, q);
     TypeSupport type(new tf2_msgs::msg::dds_::TFMessage_PubSubType());
     type.register_type(participant_);
@@ -190,10 +236,11 @@ nlohmann::json readWithCyclone(const Ros2Setting& setting, const std::string& to
 
 // The check no one here wrote the other half of: Eclipse Cyclone DDS, the DDS
 // of ROS 2's rmw_cyclonedds, with ROS 2's message types from their .msg files,
-// configured as rmw_cyclonedds configures it for each discovery setting. One
+// configured as rmw_cyclonedds configures it for each discovery setting (and
+// Fast DDS as rmw_fastrtps configures it). One
 // daemon with `localhost_only = true` (the default) must serve every setting
 // that keeps ROS 2 on the robot, the other (`false`) ROS 2's network defaults.
-TEST(Ros2, ACycloneDdsNodeReadsTfStaticUnderEachDiscoverySettingAndDiagnostics) {
+TEST(Ros2, CycloneAndFastDdsNodesReadTfStaticUnderEachDiscoverySettingAndDiagnostics) {
   TempDir dir;
   const auto gen = runTomomap("synth -o " + (dir / "world") + " -n 2 --noise low -s 4 --scale 0.5");
   ASSERT_EQ(gen.exit_code, 0) << gen.output;
@@ -238,6 +285,28 @@ TEST(Ros2, ACycloneDdsNodeReadsTfStaticUnderEachDiscoverySettingAndDiagnostics) 
     EXPECT_EQ(t["qx"].get<double>(), 0.0);
     EXPECT_EQ(t["qy"].get<double>(), 0.0);
     EXPECT_GT(t["sec"].get<int64_t>(), 1'600'000'000) << "stamped with the wall clock";
+  }
+
+  // The same with Fast DDS on the ROS 2 side, configured as rmw_fastrtps
+  // configures it for each setting.
+  const std::vector<std::tuple<FastDdsRos2, std::string, int>> fast{
+      {FastDdsRos2::humble_localhost_only, kHumbleLocalhostOnly.name, local_domain},
+      {FastDdsRos2::jazzy_localhost, kJazzyLocalhost.name, local_domain},
+      {FastDdsRos2::jazzy_subnet_static_peer, kJazzySubnetStaticPeer.name, local_domain},
+      {FastDdsRos2::defaults, kDefaults.name, network_domain},
+      {FastDdsRos2::jazzy_localhost, kJazzyLocalhost.name, network_domain}};
+  for (const auto& [setting, name, domain] : fast) {
+    SCOPED_TRACE("Fast DDS, " + name +
+                 (domain == local_domain ? ", localhost_only = true" : ", localhost_only = false"));
+    TfStaticReader reader(domain, setting);
+    ASSERT_TRUE(Fleet::waitFor([&] { return !reader.latest().empty(); }, 120s)) << "nothing on rt/tf_static";
+    const auto& msg = reader.latest().begin()->second;
+    ASSERT_EQ(msg.transforms().size(), 1u);
+    const auto& t = msg.transforms()[0];
+    EXPECT_EQ(t.child_frame_id(), "bravo_map");
+    EXPECT_NEAR(t.transform().translation().x(), bravo.x, 1e-9);
+    EXPECT_NEAR(t.transform().translation().y(), bravo.y, 1e-9);
+    EXPECT_NEAR(2 * std::atan2(t.transform().rotation().z(), t.transform().rotation().w()), bravo.yaw, 1e-9);
   }
 
   // /diagnostics, as rqt_robot_monitor reads it: each daemon's health, OK
