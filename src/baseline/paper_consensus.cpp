@@ -10,14 +10,10 @@ namespace tomomap::baseline {
 MatchResult matchPaperConsensus(const Points& target, const Points& source, MatchParams params) {
   params.exhaustive = true;  // the paper visits every slice pair once
   params.level = false;      // and takes the maps as they are
-  MatchResult r;
-  const MapFeatures t = describeMap(target, params, &r.timings), s = describeMap(source, params, &r.timings);
-  r.target_slices = t.slice_count;
-  r.source_slices = s.slice_count;
-  r.target_features = t.featureCount();
-  r.source_features = s.featureCount();
-  r.target_tilt = t.tilt.measured ? t.tilt.angle : -1;
-  r.source_tilt = s.tilt.measured ? s.tilt.angle : -1;
+  StageTimings timings;
+  const MapFeatures t = describeMap(target, params, &timings), s = describeMap(source, params, &timings);
+  MatchResult r = resultFor(t, s);
+  r.timings = timings;
   if (t.slices.empty() || s.slices.empty()) {
     r.reason = "a map has no descriptive slice";
     return r;

@@ -137,8 +137,8 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   const Tilt tilt = tilt_estimate.get();
   // Only a map that would be refused: levelling a level map by the estimate's
   // own error (0.6 deg on demo-pcd1) cost 3 cm and 0.6 deg on demo-room.
-  const bool level = params.level && tilt.angle > params.max_tilt && tilt.angle <= kMaxLevelable &&
-                     tilt.levelable(params.max_tilt);
+  const bool level =
+      params.level && tilt.angle > params.max_tilt && tilt.angle <= kMaxLevelable && tilt.levelable(params.max_tilt);
   if (level) {
     // The levelled map is filtered again: rotated voxels no longer sit on the grid.
     filtered = voxelFilter(rotatePoints(filtered, tilt.leveling()), params.grid);
@@ -154,8 +154,7 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   return f;
 }
 
-MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
-                          const Progress& progress, PairCache* cache) {
+MatchResult resultFor(const MapFeatures& target, const MapFeatures& source) {
   MatchResult r;
   r.target_slices = target.slice_count;
   r.source_slices = source.slice_count;
@@ -163,6 +162,12 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   r.source_features = source.featureCount();
   r.target_tilt = target.tilt.measured ? target.tilt.angle : -1.0;
   r.source_tilt = source.tilt.measured ? source.tilt.angle : -1.0;
+  return r;
+}
+
+MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
+                          const Progress& progress, PairCache* cache) {
+  MatchResult r = resultFor(target, source);
   Evidence e;
   e.grid = target.grid;
   auto tilted = tiltRefusal(target, "target", params);

@@ -89,6 +89,9 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
 /// level), naming it by `role`; empty if it is fine.
 std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string& role, const MatchParams& params);
 
+/// A result that has only what the two maps' descriptions say: their slices,
+/// features and tilts (no answer yet).
+MatchResult resultFor(const MapFeatures& target, const MapFeatures& source);
 /// Voxel filter, slicing, features and matching for two raw maps.
 MatchResult matchMaps(const Points& target, const Points& source, const MatchParams& params,
                       const Progress& progress = {});

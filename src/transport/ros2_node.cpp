@@ -33,6 +33,19 @@ constexpr const char* kDiagnosticsTopic = "rt/diagnostics";
 
 Eigen::Vector4d yawQuaternion(double yaw) { return {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)}; }
 
+/// ROS 2's reliable, keep-last-1 endpoints (static transforms, diagnostics,
+/// latched maps), with `durability`. Memory the size of each sample, not of
+/// the largest: a map may be tens of MB.
+template <class EndpointQos>
+EndpointQos reliableKeepLast1(EndpointQos q, DurabilityQosPolicyKind durability) {
+  q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = durability;
+  q.history().kind = KEEP_LAST_HISTORY_QOS;
+  q.history().depth = 1;
+  q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
+  return q;
+}
+
 /// Takes the map messages of both readers of the map topic (transient local
 /// and volatile: each matches writers the other cannot) and hands each on once.
 class MapListener : public DataReaderListener {
@@ -156,19 +169,12 @@ Ros2Node::Ros2Node(int ros_domain, bool localhost_only) : impl_(std::make_unique
     throw std::runtime_error("cannot create the ROS 2 participant on domain " + std::to_string(ros_domain));
   i.publisher = i.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
   if (!i.publisher) throw std::runtime_error("cannot create the ROS 2 publisher");
-  // tf2_ros::StaticTransformBroadcaster's QoS: depth 1, reliable, transient local.
-  DataWriterQos tf = DATAWRITER_QOS_DEFAULT;
-  tf.reliability().kind = RELIABLE_RELIABILITY_QOS;
-  tf.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
-  tf.history().kind = KEEP_LAST_HISTORY_QOS;
-  tf.history().depth = 1;
-  tf.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
-  i.tf_static = i.writer(TypeSupport(new ros_tf::TFMessage_PubSubType()), kTfStaticTopic, tf);
-  // diagnostic_updater's: reliable, volatile, keep last 1 (a late reader waits for the next).
-  DataWriterQos diagnostics = tf;
-  diagnostics.durability().kind = VOLATILE_DURABILITY_QOS;
-  i.diagnostics =
-      i.writer(TypeSupport(new ros_diagnostic::DiagnosticArray_PubSubType()), kDiagnosticsTopic, diagnostics);
+  // tf2_ros::StaticTransformBroadcaster's QoS: transient local.
+  i.tf_static = i.writer(TypeSupport(new ros_tf::TFMessage_PubSubType()), kTfStaticTopic,
+                         reliableKeepLast1(DATAWRITER_QOS_DEFAULT, TRANSIENT_LOCAL_DURABILITY_QOS));
+  // diagnostic_updater's: volatile (a late reader waits for the next).
+  i.diagnostics = i.writer(TypeSupport(new ros_diagnostic::DiagnosticArray_PubSubType()), kDiagnosticsTopic,
+                           reliableKeepLast1(DATAWRITER_QOS_DEFAULT, VOLATILE_DURABILITY_QOS));
 }
 
 Ros2Node::~Ros2Node() = default;
@@ -231,14 +237,7 @@ void Ros2Node::subscribeMap(const std::string& topic, std::function<void(CloudMe
   if (!subscriber) throw std::runtime_error("cannot subscribe to " + topic);
   i.map_listener = std::make_unique<MapListener>(std::move(on_message));
   for (const DurabilityQosPolicyKind durability : {TRANSIENT_LOCAL_DURABILITY_QOS, VOLATILE_DURABILITY_QOS}) {
-    DataReaderQos q = DATAREADER_QOS_DEFAULT;
-    q.reliability().kind = RELIABLE_RELIABILITY_QOS;
-    q.durability().kind = durability;
-    q.history().kind = KEEP_LAST_HISTORY_QOS;
-    q.history().depth = 1;
-    // Maps of tens of MB: memory the size of each sample, not of the largest.
-    q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
-    if (!subscriber->create_datareader(t, q, i.map_listener.get()))
+    if (!subscriber->create_datareader(t, reliableKeepLast1(DATAREADER_QOS_DEFAULT, durability), i.map_listener.get()))
       throw std::runtime_error("cannot create the reader of " + topic);
   }
 }

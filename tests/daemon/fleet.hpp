@@ -203,6 +203,27 @@ inline std::chrono::milliseconds stopTimeout() {
   return std::chrono::seconds(10);
 }
 
+/// Waits until `source`'s map version is no longer `before` and every agent
+/// of `ids` holds `pair` agreed for the new one; returns that version (empty
+/// if not within `timeout`).
+inline std::string waitForReagreement(const Fleet& fleet, const std::vector<std::string>& ids, const std::string& pair,
+                                      const std::string& source, const std::string& before,
+                                      std::chrono::seconds timeout) {
+  std::string now;
+  const bool agreed = Fleet::waitFor(
+      [&] {
+        now = fleet.readJson(source, "status.json")["map"].value("version", "");
+        if (now.empty() || now == before) return false;
+        for (const auto& id : ids) {
+          const auto t = fleet.transforms(id);
+          if (!t.count(pair) || t.at(pair)["source_version"] != now) return false;
+        }
+        return true;
+      },
+      timeout);
+  return agreed ? now : std::string();
+}
+
 /// Stops every agent with SIGTERM and checks each leaves cleanly within the
 /// unit's stop timeout.
 inline void stopAll(Fleet& fleet, const std::vector<std::string>& ids) {

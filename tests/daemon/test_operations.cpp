@@ -253,19 +253,8 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
   // Then the complete map, written beside it and renamed over it.
   std::filesystem::rename(staged, bravo_map);
 
-  std::string v2;
-  ASSERT_TRUE(Fleet::waitFor(
-      [&] {
-        v2 = fleet.readJson("bravo", "status.json")["map"].value("version", "");
-        if (v2.empty() || v2 == v1) return false;
-        for (const char* id : {"alpha", "bravo"}) {
-          const auto t = fleet.transforms(id);
-          if (!t.count("alpha<-bravo") || t.at("alpha<-bravo")["source_version"] != v2) return false;
-        }
-        return true;
-      },
-      60s))
-      << fleet.log("alpha") << fleet.log("bravo");
+  const std::string v2 = waitForReagreement(fleet, {"alpha", "bravo"}, "alpha<-bravo", "bravo", v1, 60s);
+  ASSERT_FALSE(v2.empty()) << fleet.log("alpha") << fleet.log("bravo");
 
   const auto t = fleet.transforms("alpha").at("alpha<-bravo");
   ASSERT_TRUE(t["reliable"].get<bool>()) << t.dump(2);

@@ -397,19 +397,8 @@ TEST(Ros2, AMapFromAPointCloud2TopicIsAgreedAndUpdatedLikeAMapFile) {
   writeRawPoints(dir / "v2.xyz32", withCabinet(original));
   const auto second = publishCloud(domain, topic, dir / "v2.xyz32", "xyz64");
   ASSERT_EQ(second.exit_code, 0) << second.output << fleet.log("bravo");
-  std::string v2;
-  ASSERT_TRUE(Fleet::waitFor(
-      [&] {
-        v2 = fleet.readJson("bravo", "status.json")["map"].value("version", "");
-        if (v2.empty() || v2 == v1) return false;
-        for (const char* id : {"alpha", "bravo"}) {
-          const auto t = fleet.transforms(id);
-          if (!t.count("alpha<-bravo") || t.at("alpha<-bravo")["source_version"] != v2) return false;
-        }
-        return true;
-      },
-      120s))
-      << fleet.log("alpha") << fleet.log("bravo");
+  const std::string v2 = waitForReagreement(fleet, {"alpha", "bravo"}, "alpha<-bravo", "bravo", v1, 120s);
+  ASSERT_FALSE(v2.empty()) << fleet.log("alpha") << fleet.log("bravo");
   const auto t2 = fleet.transforms("alpha").at("alpha<-bravo");
   ASSERT_TRUE(t2["reliable"].get<bool>()) << t2.dump(2);
   const PoseError e2 = poseError(poseOf(t2), gt);
