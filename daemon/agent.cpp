@@ -305,9 +305,9 @@ void Agent::finishCompute() {
   MatchWorker::Computed computed = worker_.take();
   AgreedTransform& t = computed.transform;
   ++counters_.matches_computed;
-  if (t.reliable && pairText(t.pair()) == config_.test_wrong_pair) {
+  if (t.reliable && pairText(t.pair()) == config_.faults.wrong_pair) {
     t.T_target_source = t.T_target_source * Pose4{1.5, 0, 0, radians(30)};
-    log_.warning("test_wrong_pair: " + config_.test_wrong_pair + " published moved 1.5 m and 30 deg");
+    log_.warning("test fault wrong_pair: " + config_.faults.wrong_pair + " published moved 1.5 m and 30 deg");
   }
   const Pose4& T = t.T_target_source;
   log_.info(

@@ -32,8 +32,6 @@ const std::vector<std::string> kKeys{"agent",
                                      "claim_timeout_s",
                                      "request_interval_s",
                                      "peer_memory_mb",
-                                     "test_drop_percent",
-                                     "test_wrong_pair",
                                      "reference",
                                      "peer.id",
                                      "peer.host",
@@ -320,8 +318,8 @@ Config loadConfig(const std::string& path) {
   c.claim_timeout_s = r.number(root, "claim_timeout_s", 30, 1, 3600);
   c.request_interval_s = r.number(root, "request_interval_s", 1, 0.1, 600);
   c.peer_memory_mb = r.number(root, "peer_memory_mb", c.peer_memory_mb, 1, 65536);
-  t.test_drop_percent = r.integer(root, "test_drop_percent", t.test_drop_percent, 0, 90);
-  c.test_wrong_pair = r.text(root, "test_wrong_pair", std::string());
+  c.faults = testFaultsFromEnvironment();
+  t.test_drop_percent = c.faults.drop_percent;
   readSecurity(r, root, resolve, t.security);
 
   if (const toml::node* peers = root.get("peer")) {
@@ -364,8 +362,7 @@ std::string describe(const Config& c) {
     << "\n  bandwidth_kbps = " << t.bandwidth_kbps << "\n  output_dir = " << c.output_dir
     << "\n  log_level = " << levels[static_cast<int>(c.log_level)] << "\n  claim_timeout_s = " << c.claim_timeout_s
     << "\n  request_interval_s = " << c.request_interval_s << "\n  peer_memory_mb = " << c.peer_memory_mb
-    << "\n  test_drop_percent = " << t.test_drop_percent
-    << (c.test_wrong_pair.empty() ? "" : "\n  test_wrong_pair = " + c.test_wrong_pair)
+    << (c.faults.any() ? "\n  test faults (" + std::string(kTestFaultsVariable) + ") = " + c.faults.text() : "")
     << "\n  reference = " << c.frameReference() << "\n  match.max_features = " << m.features.max_features
     << "\n  match.fast_threshold = " << m.features.fast_threshold
     << "\n  match.ransac_threshold_cells = " << m.ransac_threshold_cells

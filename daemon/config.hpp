@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/matcher.hpp"
+#include "test_faults.hpp"
 #include "transport/participant.hpp"
 
 namespace tomomap::daemon {
@@ -47,9 +48,8 @@ struct Config {
   double request_interval_s = 1;  ///< ask again for missing slices after this much silence [s]
   double peer_memory_mb = 256;    ///< memory one peer's map may take here, checked before it is allocated [MB]
   std::string reference;          ///< the fleet frame's reference agent as configured; empty: the lowest id
-  /// Test only: this pair ("target<-source"), when computed here, is published
-  /// moved 1.5 m and 30 degrees: a wrong match on demand, for the cycle checks.
-  std::string test_wrong_pair;
+  /// Faults a test asked for (test_faults.hpp): from the environment, never the file.
+  TestFaults faults;
   Ros2Config ros2;
 
   const std::string& agent() const { return transport.agent; }

@@ -44,6 +44,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   log.setThreshold(config.log_level);
+  if (config.faults.any())
+    log.warning(std::string("test faults on (") + kTestFaultsVariable + "): " + config.faults.text() +
+                "; never on a robot");
   if (check) {
     std::cout << describe(config) << "\n";
     // Not an error: at boot the map may come later, and the daemon waits for it.

@@ -52,7 +52,7 @@ struct TransportConfig {
   uint16_t data_port = 0;
   std::vector<PeerAddress> peers;
   double bandwidth_kbps = 10000;  ///< budget for all of the agent's egress [kbit/s]
-  int test_drop_percent = 0;      ///< test only: share of sent RTPS messages dropped [%]
+  int test_drop_percent = 0;      ///< test only (daemon/test_faults.hpp): share of sent RTPS messages dropped [%]
   SecurityFiles security;
 };
 

@@ -86,9 +86,9 @@ TEST(Fleet, FourAgentsFlagAWrongPairAndStillPlaceEveryMapRight) {
   TempDir dir;
   const std::vector<std::string> ids{"alpha", "bravo", "charlie", "delta"};
   // Whoever computes bravo<-delta publishes it 1.5 m and 30 degrees off.
-  SynthFleet world(dir, ids, 0.5, "test_wrong_pair = \"bravo<-delta\"\n");
+  SynthFleet world(dir, ids, 0.5);
   Fleet fleet(dir);
-  for (const auto& a : world.agents) fleet.start(a, world.agents);
+  for (const auto& a : world.agents) fleet.start(a, world.agents, {"TOMOMAPD_TEST_FAULTS=wrong_pair=bravo<-delta"});
   ASSERT_TRUE(fleet.waitForTransforms(ids, 6, 300s)) << allLogs(fleet, ids);
   ASSERT_TRUE(Fleet::waitFor(
       [&] {

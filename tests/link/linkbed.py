@@ -271,7 +271,7 @@ def main():
     p.add_argument("--dropout-at", type=float, help="the link carries nothing from this second after start ...")
     p.add_argument("--dropout-s", type=float, default=20, help="... for this long")
     p.add_argument("--dds-drop", type=int, default=0,
-                   help="percent of RTPS messages each agent's own lossy test transport drops (test_drop_percent)")
+                   help="percent of RTPS messages each agent's own lossy test transport drops (TOMOMAPD_TEST_FAULTS drop_percent)")
     p.add_argument("--timeout", type=float, default=600)
     p.add_argument("--prefix", default="tmlink")
     p.add_argument("--json", help="write the report here")
@@ -327,10 +327,12 @@ def main():
         for i in range(n):
             cfg = f"{work}/a{i}.toml"
             write_config(cfg, i, n, bed, f"{work}/world/map_{i}.pcd", f"{work}/out-a{i}", args.budget_kbps,
-                         [f"grid = {args.grid}", f"test_drop_percent = {args.dds_drop}"] + security_lines(i))
+                         [f"grid = {args.grid}"] + security_lines(i))
             log = open(f"{work}/a{i}.log", "w")
+            # A fault only tests inject: the environment, not the config (docs/operations.md, "Testing").
+            env = dict(os.environ, TOMOMAPD_TEST_FAULTS=f"drop_percent={args.dds_drop}")
             procs.append(subprocess.Popen(["ip", "netns", "exec", bed.ns(i), args.tomomapd, "--config", cfg],
-                                          stdout=log, stderr=subprocess.STDOUT))
+                                          stdout=log, stderr=subprocess.STDOUT, env=env))
         t0 = time.monotonic()
         bed.relay.impairment.t0 = t0  # a dropout counts from the agents' start
         base = [bed.tx_bytes(i) for i in range(n)]

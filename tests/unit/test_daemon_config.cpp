@@ -211,3 +211,26 @@ TEST(DaemonConfig, SecurityFilesMustExistAndBeComplete) {
       << errorOf(dir, base + "ca = \"ca.pem\"\n");
   EXPECT_NE(errorOf(dir, base + "cert = \"ca.pem\"\n").find("key 'security.cert': unknown key"), std::string::npos);
 }
+
+TEST(DaemonConfig, TestFaultsComeFromTheEnvironmentOnly) {
+  const daemon::TestFaults f = daemon::parseTestFaults("drop_percent=10,wrong_pair=bravo<-delta");
+  EXPECT_EQ(f.drop_percent, 10);
+  EXPECT_EQ(f.wrong_pair, "bravo<-delta");
+  EXPECT_EQ(f.text(), "drop_percent=10,wrong_pair=bravo<-delta");
+  EXPECT_FALSE(daemon::parseTestFaults("").any());
+  for (const char* bad : {"drop_percent=95", "drop_percent=x", "wrong_pair=bravo", "slow=1", "drop_percent"}) {
+    try {
+      daemon::parseTestFaults(bad);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("TOMOMAPD_TEST_FAULTS"), std::string::npos) << e.what();
+    }
+  }
+  // The config file has no such keys.
+  TempDir dir;
+  const std::string base = "agent = \"bravo\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n";
+  for (const char* key : {"test_drop_percent = 10\n", "test_wrong_pair = \"bravo<-alpha\"\n"}) {
+    const std::string e = errorOf(dir, base + key);
+    EXPECT_NE(e.find("unknown key"), std::string::npos) << e;
+  }
+}
