@@ -216,14 +216,20 @@ const Ros2Setting kJazzySubnetStaticPeer{
             "MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers></Discovery>")};
 /// ROS 2's defaults (Humble's, and Jazzy's SUBNET range): multicast on the network.
 const Ros2Setting kDefaults{"the defaults (Humble; Jazzy's SUBNET)", ""};
+/// Jazzy's OFF range: no multicast, no peers, a domain tag of the process's own.
+const Ros2Setting kJazzyOff{"ROS_AUTOMATIC_DISCOVERY_RANGE=OFF (Jazzy)",
+                            cyclone("<General><AllowMulticast>false</AllowMulticast></General><Discovery>"
+                                    "<ParticipantIndex>none</ParticipantIndex><Tag>ros_discovery_off_1</Tag></"
+                                    "Discovery>")};
 
 /// The last sample a Cyclone DDS reader under `setting` took from rt/`topic`
 /// on `domain` once it was done (`until`: cyclone_ros2_reader's third
 /// argument); null if it never was.
 nlohmann::json readWithCyclone(const Ros2Setting& setting, const std::string& topic, int domain,
-                               const std::string& until, std::string& output) {
-  const auto r = runBinary("env", "CYCLONEDDS_URI='" + setting.cyclonedds_uri + "' " CYCLONE_ROS2_READER_BIN " " +
-                                      topic + " " + std::to_string(domain) + " '" + until + "' 120");
+                               const std::string& until, std::string& output, int seconds = 120) {
+  const auto r =
+      runBinary("env", "CYCLONEDDS_URI='" + setting.cyclonedds_uri + "' " CYCLONE_ROS2_READER_BIN " " + topic + " " +
+                           std::to_string(domain) + " '" + until + "' " + std::to_string(seconds));
   output = r.output;
   nlohmann::json last;
   std::istringstream lines(r.output);
@@ -285,6 +291,14 @@ TEST(Ros2, CycloneAndFastDdsNodesReadTfStaticUnderEachDiscoverySettingAndDiagnos
     EXPECT_EQ(t["qx"].get<double>(), 0.0);
     EXPECT_EQ(t["qy"].get<double>(), 0.0);
     EXPECT_GT(t["sec"].get<int64_t>(), 1'600'000'000) << "stamped with the wall clock";
+  }
+
+  {
+    // OFF cuts a ROS 2 node off from every other process (rmw ignores static
+    // peers then): nothing arrives, as for any other publisher; documented.
+    SCOPED_TRACE(kJazzyOff.name);
+    std::string output;
+    EXPECT_TRUE(readWithCyclone(kJazzyOff, "tf_static", local_domain, "1", output, 5).is_null()) << output;
   }
 
   // The same with Fast DDS on the ROS 2 side, configured as rmw_fastrtps
