@@ -75,15 +75,24 @@ class PeerMaps {
   const std::set<std::string>& alive() const { return alive_; }
   /// A sample from `peer` arrived (wall time, for status).
   void seen(const std::string& peer, uint64_t wall_ms) { last_seen_ms_[peer] = wall_ms; }
-  /// Drops every peer `keep` rejects (a reload removed it from the config).
+  /// Drops everything about every peer `keep` rejects (a reload removed it
+  /// from the config): its map, held samples, stream position, transfers,
+  /// liveness and last sighting.
   template <typename Keep>
   void retain(Keep keep) {
-    for (auto it = peers_.begin(); it != peers_.end();) it = keep(it->first) ? std::next(it) : peers_.erase(it);
-    for (auto it = early_.begin(); it != early_.end();) it = keep(it->first) ? std::next(it) : early_.erase(it);
-    for (auto it = received_through_.begin(); it != received_through_.end();)
-      it = keep(it->first) ? std::next(it) : received_through_.erase(it);
-    for (auto it = unannounced_.begin(); it != unannounced_.end();)
-      it = keep(it->first) ? std::next(it) : unannounced_.erase(it);
+    const auto pruneMap = [&](auto& byPeer) {
+      for (auto it = byPeer.begin(); it != byPeer.end();) it = keep(it->first) ? std::next(it) : byPeer.erase(it);
+    };
+    const auto prune = [&](std::set<std::string>& ids) {
+      for (auto it = ids.begin(); it != ids.end();) it = keep(*it) ? std::next(it) : ids.erase(it);
+    };
+    pruneMap(peers_);
+    pruneMap(early_);
+    pruneMap(received_through_);
+    pruneMap(unannounced_);
+    pruneMap(transfers_);
+    pruneMap(last_seen_ms_);
+    prune(alive_);
   }
   /// Every peer gone (this agent left the network): sequence numbers start anew too.
   void clearAlive() {

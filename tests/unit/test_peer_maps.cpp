@@ -153,3 +153,29 @@ TEST(PeerMaps, ALivePeerWhoseAnnouncementDoesNotComeIsAskedForItWithBackOff) {
   peers.setAlive("bravo", false);
   EXPECT_EQ(announcementAsks(t0 + 61s), 0u) << "not alive";
 }
+
+// A reload that removes a peer from the config leaves nothing of it behind:
+// not its map, its transfers, its liveness nor its last sighting.
+TEST(PeerMaps, APeerDroppedByAReloadLeavesNothingBehind) {
+  Log log(LogLevel::Error);
+  PeerMaps peers("alpha", log, 256u << 20);
+  const auto& offer = bravoOffer();
+  const auto all = samplesOf(offer);
+  peers.setAlive("bravo", true);
+  peers.seen("bravo", 1000);
+  peers.announce(offer.announcement, t0);
+  for (size_t i = 0; i < all.size(); ++i) peers.receive(all[i], 1000, i + 1, t0 + 300ms);
+  ASSERT_TRUE(peers.features("bravo"));
+  const transport::PeerAddress bravo{"bravo", "10.0.0.2", 7400};
+  ASSERT_EQ(peers.status(bravo)["transfers"].size(), 1u);
+
+  peers.retain([](const std::string& id) { return id != "bravo"; });
+  EXPECT_FALSE(peers.features("bravo"));
+  EXPECT_FALSE(peers.version("bravo"));
+  EXPECT_EQ(peers.aliveCount(), 0u);
+  const auto s = peers.status(bravo);
+  EXPECT_FALSE(s["alive"].get<bool>());
+  EXPECT_FALSE(s.contains("last_seen_ms")) << s.dump();
+  EXPECT_TRUE(s["transfers"].empty()) << s.dump();
+  EXPECT_EQ(peers.totals().maps, 0u);
+}
