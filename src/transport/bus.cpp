@@ -157,6 +157,25 @@ struct TopicQos {
   bool best_effort = false;
 };
 
+/// The latest sample of each of `instances` instances (keep last 1),
+/// reliable; kept for late joiners where `for_late_joiners` (transient local).
+TopicQos latestOfEach(int instances, bool for_late_joiners) {
+  TopicQos t;
+  t.transient_local = for_late_joiners;
+  t.max_instances = instances;
+  return t;
+}
+
+/// Up to `samples` samples of one instance, best effort, none kept for late joiners.
+TopicQos everySampleBestEffort(int samples) {
+  TopicQos t;
+  t.keep_all = true;
+  t.max_samples = samples;
+  t.max_instances = 1;
+  t.best_effort = true;
+  return t;
+}
+
 /// What writer and reader of a topic agree on: reliable, durability, history
 /// and its limits, and samples allocated at their real size (not the IDL bound).
 template <typename EndpointQos>
@@ -244,9 +263,9 @@ Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<
     if (!i.publisher || !i.subscriber) throw std::runtime_error("cannot create publisher/subscriber");
     // Announcements and estimates: one per agent / pair, kept for late joiners.
     i.announcements = i.addTopic<wire::MapAnnouncementPubSubType, wire::MapAnnouncement>(
-        "tomomap/announcements", {true, false, 1, 0, 256}, bySample(h.announcement));
+        "tomomap/announcements", latestOfEach(256, true), bySample(h.announcement));
     i.slices = i.addTopic<wire::SliceFeaturesPubSubType, wire::SliceFeatures>(
-        "tomomap/slices", {true, false, 1, 0, kSliceInstances},
+        "tomomap/slices", latestOfEach(kSliceInstances, true),
         [on = h.slice](wire::SliceFeatures&& s, uint64_t sequence) {
           if (!on) return;
           for (auto& piece : unbundle(std::move(s))) {
@@ -258,11 +277,12 @@ Bus::Bus(const TransportConfig& config, BusHandlers h) : impl_(std::make_unique<
     // Requests: best effort, since a receiver repeats them while it lacks
     // something, and a reliable one delivered after a dropout was stale.
     i.requests = i.addTopic<wire::ChunkRequestPubSubType, wire::ChunkRequest>(
-        "tomomap/requests", {false, true, 1, 256, 1, true}, bySample(h.request));
-    i.claims = i.addTopic<wire::MatchClaimPubSubType, wire::MatchClaim>("tomomap/claims", {false, false, 1, 0, 1024},
+        "tomomap/requests", everySampleBestEffort(256), bySample(h.request));
+    // Claims: only the current one matters, and only to those listening now.
+    i.claims = i.addTopic<wire::MatchClaimPubSubType, wire::MatchClaim>("tomomap/claims", latestOfEach(1024, false),
                                                                         bySample(h.claim));
     i.estimates = i.addTopic<wire::TransformEstimatePubSubType, wire::TransformEstimate>(
-        "tomomap/estimates", {true, false, 1, 0, 1024}, bySample(h.estimate));
+        "tomomap/estimates", latestOfEach(1024, true), bySample(h.estimate));
   } catch (...) {
     i.participant->delete_contained_entities();
     DomainParticipantFactory::get_instance()->delete_participant(i.participant);
