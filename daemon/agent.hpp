@@ -14,6 +14,7 @@
 
 #include "clock.hpp"
 #include "config.hpp"
+#include "fleet_outputs.hpp"
 #include "log.hpp"
 #include "map_sender.hpp"
 #include "map_watch.hpp"
@@ -120,13 +121,9 @@ class Agent {
   void persist(bool transforms_changed);
   /// At start: the transforms this agent stored before (transforms.json).
   void restoreTransforms();
-  /// Builds the fleet's frame from the agreed transforms (agent_frame.cpp).
-  void updateFrame();
   /// Creates the ROS 2 node when [ros2] asks for it (a failure is logged:
   /// the fleet works on without it).
   void startRos2();
-  /// Publishes the fleet frame's tree on /tf_static if it changed.
-  void publishTree();
   /// Publishes `status` (status.json's content) on /diagnostics, once per
   /// kDiagnosticsPeriod at most.
   void publishDiagnostics(const nlohmann::json& status);
@@ -136,9 +133,8 @@ class Agent {
   Config config_;
   Log& log_;
   std::unique_ptr<transport::Bus> bus_;
-  FleetFrame frame_;  ///< every agent's pose in the reference's map, and each pair's verdict
+  FleetOutputs outputs_{log_};  ///< the fleet's frame, transforms.json and frame.json, /tf_static
   std::unique_ptr<transport::Ros2Node> ros2_;
-  std::optional<std::vector<TreeEdge>> tf_published_;  ///< what /tf_static holds; none before the first sample
   std::optional<Clock::time_point> diagnostics_published_;
   /// The latest map message from [ros2] map_topic not yet described; one at a
   /// time: a SLAM package may publish its map with every scan.
@@ -167,9 +163,8 @@ class Agent {
   Counters counters_;
   std::map<std::string, std::string> other_grid_;  ///< peers whose map uses another grid, and what to say
   Clock::time_point last_status_{};
-  bool transforms_unwritten_ = false;  ///< transforms.json is behind: its last write failed
-  std::string write_error_;            ///< why the last write of a state file failed; empty once one succeeds
-  RejectionLog rejections_;            ///< warnings for rejected samples, bounded per sender
+  bool status_unwritten_ = false;  ///< status.json's last write failed
+  RejectionLog rejections_;        ///< warnings for rejected samples, bounded per sender
   bool reannounce_ =
       false;  ///< a peer asked for our announcement: announce again (tick, once for peers that ask together)
   Clock::time_point started_ = Clock::now();

@@ -12,22 +12,11 @@ namespace {
 /// diagnostic_updater's default period: what rqt_robot_monitor expects.
 constexpr auto kDiagnosticsPeriod = std::chrono::seconds(1);
 
-bool sameTree(const std::vector<TreeEdge>& a, const std::vector<TreeEdge>& b) {
-  if (a.size() != b.size()) return false;
-  for (size_t i = 0; i < a.size(); ++i) {
-    const Pose4 &p = a[i].T_parent_child, &q = b[i].T_parent_child;
-    if (a[i].parent != b[i].parent || a[i].child != b[i].child || a[i].stamp_ms != b[i].stamp_ms || p.x != q.x ||
-        p.y != q.y || p.z != q.z || p.yaw != q.yaw)
-      return false;
-  }
-  return true;
-}
-
 }  // namespace
 
 void Agent::startRos2() {
   ros2_.reset();
-  tf_published_.reset();
+  outputs_.setTreePublisher({});
   diagnostics_published_.reset();
   if (!config_.ros2.enabled) return;
   try {
@@ -45,6 +34,7 @@ void Agent::startRos2() {
       });
       log_.info("ROS 2: reading this robot's map from " + config_.ros2.map_topic + " (sensor_msgs/PointCloud2)");
     }
+    outputs_.setTreePublisher([node = ros2_.get()](const auto& frames) { node->publishTfStatic(frames); });
     log_.info("ROS 2: publishing the fleet's frames on /tf_static and this daemon's health on /diagnostics (domain " +
               std::to_string(config_.ros2.domain) + ", root frame " + config_.ros2.frameOf(config_.treeRoot()) + ")");
   } catch (const std::exception& e) {
@@ -53,30 +43,12 @@ void Agent::startRos2() {
   }
 }
 
-void Agent::publishTree() {
-  if (!ros2_) return;
-  uint64_t stamp_ms = 0;  // the newest transform behind the frame
-  for (const auto& [key, t] : board_.results())
-    if (t.reliable) stamp_ms = std::max(stamp_ms, t.computed_at_ms);
-  std::vector<TreeEdge> tree = treeOf(frame_, config_.treeRoot(), stamp_ms);
-  // An empty tree is published too, once: a late reader then gets a sample.
-  if (tf_published_ && sameTree(tree, *tf_published_)) return;
-  std::vector<transport::TfFrame> frames;
-  for (const auto& e : tree)
-    frames.push_back({config_.ros2.frameOf(e.parent), config_.ros2.frameOf(e.child), e.T_parent_child, e.stamp_ms});
-  ros2_->publishTfStatic(frames);
-  log_.info("ROS 2: /tf_static holds " + std::to_string(frames.size()) + " of the fleet's " +
-            std::to_string(config_.transport.peers.size()) + " other frames under " +
-            config_.ros2.frameOf(config_.treeRoot()));
-  tf_published_ = std::move(tree);
-}
-
 void Agent::publishDiagnostics(const nlohmann::json& status) {
   if (!ros2_) return;
   const auto now = Clock::now();
   if (diagnostics_published_ && now - *diagnostics_published_ < kDiagnosticsPeriod) return;
   diagnostics_published_ = now;
-  ros2_->publishDiagnostics({diagnosticOf(status, toJson(frame_), statusLine())}, wallMs());
+  ros2_->publishDiagnostics({diagnosticOf(status, toJson(outputs_.frame()), statusLine())}, wallMs());
 }
 
 }  // namespace tomomap::daemon

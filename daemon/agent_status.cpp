@@ -16,27 +16,11 @@ namespace fs = std::filesystem;
 void Agent::persist(bool transforms_changed) {
   const fs::path dir(config_.output_dir);
   if (transforms_changed) {
-    updateFrame();
-    publishTree();  // the other way results leave the daemon
-  }
-  if (transforms_changed || transforms_unwritten_) {
-    try {
-      nlohmann::json list = nlohmann::json::array();
-      for (const auto& [key, t] : board_.results()) list.push_back(toJson(t));
-      writeJsonAtomically((dir / "transforms.json").string(),
-                          {{"schema_version", kJsonSchemaVersion}, {"agent", config_.agent()}, {"transforms", list}});
-      nlohmann::json frame = toJson(frame_);
-      frame["schema_version"] = kJsonSchemaVersion;
-      frame["agent"] = config_.agent();
-      writeJsonAtomically((dir / "frame.json").string(), frame);
-      if (transforms_unwritten_) log_.info("transforms.json written again: it holds every agreed transform");
-      transforms_unwritten_ = false;
-    } catch (const std::exception& e) {
-      // Said once per failing spell; retried with every status write (tick).
-      if (!transforms_unwritten_) log_.error(std::string("cannot write transforms.json (retrying): ") + e.what());
-      transforms_unwritten_ = true;
-      write_error_ = e.what();
-    }
+    std::vector<AgreedTransform> agreed;
+    for (const auto& [key, t] : board_.results()) agreed.push_back(t);
+    outputs_.update(agreed, config_);
+  } else {
+    outputs_.retry(config_);
   }
   try {
     nlohmann::json peers = nlohmann::json::object();
@@ -91,14 +75,14 @@ void Agent::persist(bool transforms_changed) {
         {"dropped_impostor_samples", counters_.impostors},
         {"refused_participants", counters_.refused_participants},
         {"secure", config_.transport.security.enabled()},
-        {"transforms_unwritten", transforms_unwritten_},
-        {"write_error", transforms_unwritten_ ? write_error_ : std::string()}};
+        {"transforms_unwritten", outputs_.unwritten()},
+        {"write_error", outputs_.writeError()}};
     publishDiagnostics(status);
     writeJsonAtomically((dir / "status.json").string(), status);
-    if (!transforms_unwritten_) write_error_.clear();
+    status_unwritten_ = false;
   } catch (const std::exception& e) {
-    if (write_error_.empty()) log_.error(std::string("cannot write status.json (retrying): ") + e.what());
-    write_error_ = e.what();
+    if (!status_unwritten_) log_.error(std::string("cannot write status.json (retrying): ") + e.what());
+    status_unwritten_ = true;
   }
 }
 
