@@ -112,8 +112,9 @@ struct Peak {
 std::vector<int> landings(const std::vector<Cell>& cells, const Rigid2D& T, const SliceGrid& grid) {
   std::vector<int> out;
   out.reserve(cells.size());
+  const Rigid2D::Applier move = T.applier();
   for (const Cell& c : cells) {
-    const Eigen::Vector2d q = T.apply(c.p);
+    const Eigen::Vector2d q = move(c.p);
     const Eigen::Vector2d f = grid.toPixel(q.x(), q.y());
     const int u = static_cast<int>(std::lround(f.x())), v = static_cast<int>(std::lround(f.y()));
     out.push_back(u < 0 || v < 0 || u >= grid.width || v >= grid.height ? -1 : v * grid.width + u);

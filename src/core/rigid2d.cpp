@@ -42,8 +42,9 @@ RigidEstimate refineLeastSquares(const Correspondences& c, RigidEstimate est, do
 std::vector<uint32_t> collectInliers(const Correspondences& c, const Rigid2D& T, double threshold) {
   std::vector<uint32_t> in;
   const double t2 = threshold * threshold;
+  const Rigid2D::Applier move = T.applier();
   for (uint32_t i = 0; i < c.size(); ++i)
-    if ((T.apply(c.source[i]) - c.target[i]).squaredNorm() <= t2) in.push_back(i);
+    if ((move(c.source[i]) - c.target[i]).squaredNorm() <= t2) in.push_back(i);
   return in;
 }
 
