@@ -49,29 +49,20 @@ int main(int argc, char** argv) {
   msg.header.stamp.sec = 1700000000;
   msg.is_bigendian = false;
   msg.is_dense = true;
-  msg.fields._buffer = calloc(4, sizeof(sensor_msgs_msg_dds__PointField_));
+  /* xyz64: float64 (datatype 8) x, y, z and padding, in two rows (the first
+   * n / 2 points, then the rest), each padded by 16 bytes. xyzi32: float32
+   * (7) x, y, z and intensity in one row. */
+  static const char* const names[] = {"x", "y", "z", "intensity"};
+  const uint8_t datatype = wide ? 8 : 7;
+  const uint32_t coordinate = wide ? 8 : 4, fields = wide ? 3 : 4;
+  msg.fields._buffer = calloc(fields, sizeof(sensor_msgs_msg_dds__PointField_));
   msg.fields._release = true;
-  if (wide) {
-    /* Two rows: the first n / 2 points, then the rest, each row padded by 16 bytes. */
-    put_field(&msg.fields._buffer[0], "x", 0, 8);
-    put_field(&msg.fields._buffer[1], "y", 8, 8);
-    put_field(&msg.fields._buffer[2], "z", 16, 8);
-    msg.fields._length = msg.fields._maximum = 3;
-    msg.point_step = 32;
-    msg.height = 2;
-    msg.width = (n + 1) / 2;
-    msg.row_step = msg.width * msg.point_step + 16;
-  } else {
-    put_field(&msg.fields._buffer[0], "x", 0, 7);
-    put_field(&msg.fields._buffer[1], "y", 4, 7);
-    put_field(&msg.fields._buffer[2], "z", 8, 7);
-    put_field(&msg.fields._buffer[3], "intensity", 12, 7);
-    msg.fields._length = msg.fields._maximum = 4;
-    msg.point_step = 16;
-    msg.height = 1;
-    msg.width = n;
-    msg.row_step = n * 16;
-  }
+  msg.fields._length = msg.fields._maximum = fields;
+  for (uint32_t k = 0; k < fields; ++k) put_field(&msg.fields._buffer[k], names[k], k * coordinate, datatype);
+  msg.point_step = wide ? 32 : 16;
+  msg.height = wide ? 2 : 1;
+  msg.width = wide ? (n + 1) / 2 : n;
+  msg.row_step = msg.width * msg.point_step + (wide ? 16 : 0);
   const size_t size = (size_t)msg.height * msg.row_step;
   uint8_t* data = calloc(size, 1);
   for (uint32_t i = 0; i < n; ++i) {
@@ -128,10 +119,7 @@ int main(int argc, char** argv) {
     fprintf(stderr, "cyclone_cloud_publisher: no reader acknowledged %s within %s s\n", topic_name, argv[6]);
   }
   dds_delete(participant);
-  free(msg.fields._buffer[0].name);
-  free(msg.fields._buffer[1].name);
-  free(msg.fields._buffer[2].name);
-  if (!wide) free(msg.fields._buffer[3].name);
+  for (uint32_t k = 0; k < fields; ++k) free(msg.fields._buffer[k].name);
   free(msg.fields._buffer);
   free(data);
   free(xyz);
