@@ -1,5 +1,6 @@
 #include "agent.hpp"
 
+#include "core/map_check.hpp"
 #include "core/text.hpp"
 #include "io/map_io.hpp"
 #include "io/point_cloud2.hpp"
@@ -68,11 +69,14 @@ OwnMap describeOwnMap(const Config& config, const transport::CloudMessage& cloud
   OwnMap own;
   own.frame_id = cloud.frame_id;
   return describeLoaded(config, std::move(own), [&](OwnMap& o) {
+    Points points;
     try {
-      return pointsFromCloud2(cloud.layout, cloud.data.data(), cloud.data.size(), &o.nonfinite);
+      points = pointsFromCloud2(cloud.layout, cloud.data.data(), cloud.data.size(), &o.nonfinite);
     } catch (const InputError& e) {
       throw InputError(mapSource(config) + ": " + e.what());
     }
+    validateMap(points, mapSource(config));  // as a map file is (loadMap): an empty or tiny map is refused
+    return points;
   });
 }
 

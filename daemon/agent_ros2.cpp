@@ -38,6 +38,8 @@ void Agent::startRos2() {
     log_.info("ROS 2: publishing the fleet's frames on /tf_static and this daemon's health on /diagnostics (domain " +
               std::to_string(config_.ros2.domain) + ", root frame " + config_.ros2.frameOf(config_.treeRoot()) + ")");
   } catch (const std::exception& e) {
+    ros2_.reset();  // half made (its map reader refused, say): none, so a map from the topic is known not to come
+    outputs_.setTreePublisher({});
     log_.error(std::string("ROS 2: cannot publish /tf_static and /diagnostics (") + e.what() +
                "); transforms.json is still written");
   }
@@ -48,7 +50,7 @@ void Agent::publishDiagnostics(const nlohmann::json& status) {
   const auto now = Clock::now();
   if (diagnostics_published_ && now - *diagnostics_published_ < kDiagnosticsPeriod) return;
   diagnostics_published_ = now;
-  ros2_->publishDiagnostics({diagnosticOf(status, toJson(outputs_.frame()), statusLine())}, wallMs());
+  ros2_->publishDiagnostics({diagnosticOf(status, outputs_.frame(), statusLine())}, wallMs());
 }
 
 }  // namespace tomomap::daemon

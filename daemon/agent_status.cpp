@@ -18,7 +18,7 @@ void Agent::persist(bool transforms_changed) {
   if (transforms_changed) {
     std::vector<AgreedTransform> agreed;
     for (const auto& [key, t] : board_.results()) agreed.push_back(t);
-    outputs_.update(agreed, config_);
+    outputs_.update(std::move(agreed), config_);
   } else {
     outputs_.retry(config_);
   }

@@ -156,7 +156,6 @@ void readMatch(const Reader& r, const toml::table& root, MatchParams& m) {
   m.max_tilt = radians(r.number(*t, "max_tilt_deg", degrees(m.max_tilt), 0, 90));
 }
 
-/// The [ros2] table: present means on, unless it says `enabled = false`.
 /// A ROS 2 topic name: segments of letters, digits and _, not starting with a
 /// digit, separated by / (a leading / or none: relative names resolve to the root).
 bool validRosTopic(const std::string& name) {
@@ -176,6 +175,7 @@ bool validRosTopic(const std::string& name) {
   return true;
 }
 
+/// The [ros2] table: present means on, unless it says `enabled = false`.
 void readRos2(const Reader& r, const toml::table& root, Config& c) {
   const toml::table* t = knownTable(r, root, "ros2");
   if (!t) return;

@@ -21,8 +21,7 @@ std::string peerText(const nlohmann::json& p) {
 
 }  // namespace
 
-transport::Diagnostic diagnosticOf(const nlohmann::json& status, const nlohmann::json& frame,
-                                   const std::string& summary) {
+transport::Diagnostic diagnosticOf(const nlohmann::json& status, const FleetFrame& frame, const std::string& summary) {
   using transport::Diagnostic;
   Diagnostic d;
   const std::string agent = status.value("agent", "");
@@ -61,14 +60,11 @@ transport::Diagnostic diagnosticOf(const nlohmann::json& status, const nlohmann:
     }
     d.values.emplace_back("pair " + pair, value);
   }
-  std::vector<std::string> inconsistent;
-  if (frame.contains("pairs"))
-    for (const auto& v : frame["pairs"])
-      if (v.value("verdict", "") == "inconsistent") inconsistent.push_back(v.value("pair", ""));
   std::string list;
-  for (const auto& pair : inconsistent) {
-    list += (list.empty() ? "" : ", ") + pair;
-    warnings.push_back(pair + " is inconsistent with the fleet's other transforms");
+  for (const auto& v : frame.pairs) {
+    if (v.verdict != Consistency::Inconsistent) continue;
+    list += (list.empty() ? "" : ", ") + pairText(v.pair);
+    warnings.push_back(pairText(v.pair) + " is inconsistent with the fleet's other transforms");
   }
   d.values.emplace_back("inconsistent pairs", list.empty() ? "none" : list);
 

@@ -27,8 +27,8 @@ void FleetOutputs::setTreePublisher(TreePublisher publish) {
   published_.reset();
 }
 
-void FleetOutputs::update(const std::vector<AgreedTransform>& agreed, const Config& config) {
-  agreed_ = agreed;
+void FleetOutputs::update(std::vector<AgreedTransform> agreed, const Config& config) {
+  agreed_ = std::move(agreed);
   rebuildFrame(config);
   handTree(config);
   write(config);

@@ -28,7 +28,7 @@ class FleetOutputs {
   void setTreePublisher(TreePublisher publish);
   /// The agreed transforms changed: the frame is rebuilt (a pair that turns
   /// inconsistent said once), the tree handed on if it changed, the files written.
-  void update(const std::vector<AgreedTransform>& agreed, const Config& config);
+  void update(std::vector<AgreedTransform> agreed, const Config& config);
   /// Writes the files again if the last write failed (said once it works).
   void retry(const Config& config);
 

@@ -19,8 +19,8 @@ class BitRaster {
   }
   /// Calls f(u) for every occupied u in [u_lo, u_hi] of row v, in order: a
   /// word at a time, so the empty stretches that most of a search window is
-  /// cost one test each (the refinement took 60 % of a demo-room match when it
-  /// tested every cell of the window).
+  /// cost one test each (demo-room's refinement: 0.038 -> 0.032 s, against
+  /// testing every cell of the window).
   template <typename F>
   void forEachOccupied(int v, int u_lo, int u_hi, F&& f) const {
     const uint64_t* row = words_.data() + static_cast<size_t>(v) * words_per_row_;

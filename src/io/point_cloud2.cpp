@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/map_check.hpp"
+
 namespace tomomap {
 namespace {
 
@@ -53,19 +55,16 @@ Points pointsFromCloud2(const PointCloud2Layout& layout, const uint8_t* data, si
                      std::to_string(layout.point_step) + " bytes) needs " + std::to_string(needed));
   Points points;
   points.reserve(static_cast<size_t>(layout.height) * layout.width);
-  size_t dropped = 0;
   for (uint32_t row = 0; row < layout.height; ++row) {
     const uint8_t* p = data + static_cast<size_t>(row) * layout.row_step;
     for (uint32_t i = 0; i < layout.width; ++i, p += layout.point_step) {
-      const double x = read(p + fx->offset, fx->datatype), y = read(p + fy->offset, fy->datatype),
-                   z = read(p + fz->offset, fz->datatype);
-      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
-        ++dropped;
-        continue;
-      }
-      points.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+      points.emplace_back(static_cast<float>(read(p + fx->offset, fx->datatype)),
+                          static_cast<float>(read(p + fy->offset, fy->datatype)),
+                          static_cast<float>(read(p + fz->offset, fz->datatype)));
     }
   }
+  // A float64 beyond float's range becomes infinite here, and is dropped with the holes.
+  const size_t dropped = dropNonFinite(points);
   if (nonfinite) *nonfinite = dropped;
   return points;
 }

@@ -33,6 +33,14 @@ constexpr const char* kDiagnosticsTopic = "rt/diagnostics";
 
 Eigen::Vector4d yawQuaternion(double yaw) { return {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)}; }
 
+/// builtin_interfaces/Time for `ms` [ms since the epoch].
+builtin_interfaces::msg::dds_::Time_ rosTime(uint64_t ms) {
+  builtin_interfaces::msg::dds_::Time_ t;
+  t.sec(static_cast<int32_t>(ms / 1000));
+  t.nanosec(static_cast<uint32_t>(ms % 1000) * 1000000u);
+  return t;
+}
+
 /// ROS 2's reliable, keep-last-1 endpoints (static transforms, diagnostics,
 /// latched maps), with `durability`. Memory the size of each sample, not of
 /// the largest: a map may be tens of MB.
@@ -66,7 +74,6 @@ class MapListener : public DataReaderListener {
       for (const auto& f : msg.fields()) m.layout.fields.push_back({f.name(), f.offset(), f.datatype(), f.count()});
       m.data = std::move(msg.data());
       m.frame_id = msg.header().frame_id();
-      m.stamp_ms = static_cast<uint64_t>(msg.header().stamp().sec()) * 1000 + msg.header().stamp().nanosec() / 1000000;
       on_message_(std::move(m));
     }
   }
@@ -95,13 +102,19 @@ struct Ros2Node::Impl {
   DataWriter* diagnostics = nullptr;
   std::unique_ptr<MapListener> map_listener;
 
-  /// A writer of `type` on `topic`.
-  DataWriter* writer(TypeSupport type, const char* topic, const DataWriterQos& qos) {
+  /// `topic` with its `type` registered.
+  Topic* topic(TypeSupport type, const std::string& name) {
     if (type.register_type(participant) != ReturnCode_t::RETCODE_OK)
       throw std::runtime_error("cannot register " + type.get_type_name());
-    Topic* t = participant->create_topic(topic, type.get_type_name(), TOPIC_QOS_DEFAULT);
-    DataWriter* w = t ? publisher->create_datawriter(t, qos) : nullptr;
-    if (!w) throw std::runtime_error(std::string("cannot create the writer of ") + topic);
+    Topic* t = participant->create_topic(name, type.get_type_name(), TOPIC_QOS_DEFAULT);
+    if (!t) throw std::runtime_error("cannot create the topic " + name);
+    return t;
+  }
+
+  /// A writer of `type` on `name`.
+  DataWriter* writer(TypeSupport type, const std::string& name, const DataWriterQos& qos) {
+    DataWriter* w = publisher->create_datawriter(topic(std::move(type), name), qos);
+    if (!w) throw std::runtime_error("cannot create the writer of " + name);
     return w;
   }
 
@@ -183,8 +196,7 @@ void Ros2Node::publishTfStatic(const std::vector<TfFrame>& frames) {
   ros_tf::TFMessage_ msg;
   for (const auto& f : frames) {
     ros_geometry::TransformStamped_ t;
-    t.header().stamp().sec(static_cast<int32_t>(f.stamp_ms / 1000));
-    t.header().stamp().nanosec(static_cast<uint32_t>(f.stamp_ms % 1000) * 1000000u);
+    t.header().stamp(rosTime(f.stamp_ms));
     t.header().frame_id(f.parent);
     t.child_frame_id(f.child);
     t.transform().translation().x(f.T_parent_child.x);
@@ -202,8 +214,7 @@ void Ros2Node::publishTfStatic(const std::vector<TfFrame>& frames) {
 
 void Ros2Node::publishDiagnostics(const std::vector<Diagnostic>& statuses, uint64_t stamp_ms) {
   ros_diagnostic::DiagnosticArray_ msg;
-  msg.header().stamp().sec(static_cast<int32_t>(stamp_ms / 1000));
-  msg.header().stamp().nanosec(static_cast<uint32_t>(stamp_ms % 1000) * 1000000u);
+  msg.header().stamp(rosTime(stamp_ms));
   for (const auto& d : statuses) {
     ros_diagnostic::DiagnosticStatus_ s;
     s.level(static_cast<uint8_t>(d.level));
@@ -221,19 +232,12 @@ void Ros2Node::publishDiagnostics(const std::vector<Diagnostic>& statuses, uint6
   impl_->diagnostics->write(&msg);
 }
 
-}  // namespace tomomap::transport
-
-namespace tomomap::transport {
-
 void Ros2Node::subscribeMap(const std::string& topic, std::function<void(CloudMessage&&)> on_message) {
   auto& i = *impl_;
-  TypeSupport type(new ros_sensor::PointCloud2_PubSubType());
-  if (type.register_type(i.participant) != ReturnCode_t::RETCODE_OK)
-    throw std::runtime_error("cannot register " + type.get_type_name());
   // ROS 2's names: "rt" + the topic's absolute name.
-  const std::string dds_topic = "rt" + (topic.rfind('/', 0) == 0 ? topic : "/" + topic);
-  Topic* t = i.participant->create_topic(dds_topic, type.get_type_name(), TOPIC_QOS_DEFAULT);
-  Subscriber* subscriber = t ? i.participant->create_subscriber(SUBSCRIBER_QOS_DEFAULT) : nullptr;
+  Topic* t = i.topic(TypeSupport(new ros_sensor::PointCloud2_PubSubType()),
+                     "rt" + (topic.rfind('/', 0) == 0 ? topic : "/" + topic));
+  Subscriber* subscriber = i.participant->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
   if (!subscriber) throw std::runtime_error("cannot subscribe to " + topic);
   i.map_listener = std::make_unique<MapListener>(std::move(on_message));
   for (const DurabilityQosPolicyKind durability : {TRANSIENT_LOCAL_DURABILITY_QOS, VOLATILE_DURABILITY_QOS}) {

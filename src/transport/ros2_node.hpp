@@ -40,7 +40,6 @@ struct CloudMessage {
   PointCloud2Layout layout;
   std::vector<uint8_t> data;
   std::string frame_id;
-  uint64_t stamp_ms = 0;  ///< the header's stamp [ms since the epoch]
 };
 
 class Ros2Node {

@@ -1,4 +1,4 @@
-// The daemon's health on /diagnostics, read off status.json and frame.json.
+// The daemon's health on /diagnostics, read off status.json and the fleet's frame.
 #include <gtest/gtest.h>
 
 #include "diagnostics.hpp"
@@ -27,7 +27,7 @@ std::string value(const Diagnostic& d, const std::string& key) {
 }  // namespace
 
 TEST(Diagnostics, AHealthyDaemonIsOkAndSaysItsSummary) {
-  const Diagnostic d = daemon::diagnosticOf(healthy(), {{"pairs", nlohmann::json::array()}}, "1/1 peers up");
+  const Diagnostic d = daemon::diagnosticOf(healthy(), FleetFrame{}, "1/1 peers up");
   EXPECT_EQ(d.level, Diagnostic::ok);
   EXPECT_EQ(d.name, "tomomapd: alpha");
   EXPECT_EQ(d.hardware_id, "alpha");
@@ -44,7 +44,11 @@ TEST(Diagnostics, WhatAnOperatorMustLookAtWarnsAndAWriteErrorIsAnError) {
   nlohmann::json s = healthy();
   s["peers"]["bravo"]["alive"] = false;
   s["pairs"][0] = {{"pair", "alpha<-bravo"}, {"state", "kept"}, {"why", "no reliable match: too few slices"}};
-  const nlohmann::json frame = {{"pairs", {{{"pair", "alpha<-charlie"}, {"verdict", "inconsistent"}}}}};
+  FleetFrame frame;
+  PairVerdict inconsistent;
+  inconsistent.pair = {"alpha", "charlie"};
+  inconsistent.verdict = Consistency::Inconsistent;
+  frame.pairs.push_back(inconsistent);
   Diagnostic d = daemon::diagnosticOf(s, frame, "summary");
   EXPECT_EQ(d.level, Diagnostic::warn);
   EXPECT_EQ(d.message,
@@ -61,7 +65,7 @@ TEST(Diagnostics, WhatAnOperatorMustLookAtWarnsAndAWriteErrorIsAnError) {
   nlohmann::json waiting = healthy();
   waiting["map"]["waiting"] = true;
   waiting["map"].erase("tilt_deg");
-  d = daemon::diagnosticOf(waiting, {}, "summary");
+  d = daemon::diagnosticOf(waiting, FleetFrame{}, "summary");
   EXPECT_EQ(d.level, Diagnostic::warn);
   EXPECT_EQ(value(d, "map tilt [deg]"), "not measured");
 }
