@@ -63,15 +63,24 @@ std::vector<AgreedTransform> PairBoard::mapAnnounced(const std::string& agent, u
   maps_[agent] = {version, agent == me_};
   std::vector<AgreedTransform> stored;
   for (auto it = pending_.begin(); it != pending_.end();) {
+    const AgreedTransform& t = it->second;
     const PairKey& key = it->first.first;
-    const bool decidable = (key.first == agent || key.second == agent) && versionOf(key.first) && versionOf(key.second);
-    if (!decidable) {
+    if (key.first != agent && key.second != agent) {
       ++it;
       continue;
     }
-    AgreedTransform t = std::move(it->second);
+    const uint64_t its_version = key.first == agent ? t.target_version : t.source_version;
+    if (its_version != version) {
+      it = pending_.erase(it);  // the map is at another version now: the estimate is not for it
+      continue;
+    }
+    if (!isCurrent(t)) {
+      ++it;  // the other map's announcement may still be on its way
+      continue;
+    }
+    AgreedTransform current = std::move(it->second);
     it = pending_.erase(it);
-    if (estimateSeen(t) == Offer::Stored) stored.push_back(std::move(t));
+    if (estimateSeen(current) == Offer::Stored) stored.push_back(std::move(current));
   }
   return stored;
 }
@@ -111,15 +120,16 @@ void PairBoard::claimSeen(const std::string& claimer, const PairAt& claim, Clock
 }
 
 PairBoard::Offer PairBoard::estimateSeen(AgreedTransform t) {
-  const PairKey key = t.pair();
-  const auto vt = versionOf(key.first), vs = versionOf(key.second);
-  if ((vt && *vt != t.target_version) || (vs && *vs != t.source_version)) return Offer::Outdated;
-  if (!vt || !vs) {
-    // The announcement may still be on its way (estimates and announcements
-    // travel apart): decide when it is here.
-    pending_[{key, t.computed_by}] = std::move(t);
+  if (!isCurrent(t)) {
+    // Estimates and announcements travel apart: this one may be ahead of the
+    // announcement of a map's new version (the soak run saw a peer compute a
+    // pair for its new map before that map's announcement reached us), or
+    // replayed from before. Versions are hashes, so the two look alike: the
+    // next announcement of either map decides (mapAnnounced).
+    pending_[{t.pair(), t.computed_by}] = std::move(t);
     return Offer::Pending;
   }
+  const PairKey key = t.pair();
   for (const auto* held : {&results_, &unreliable_})
     if (const auto it = held->find(key); it != held->end() && it->second.isFor(t.target_version, t.source_version) &&
                                          !outranks(t.computed_by, it->second.computed_by))

@@ -75,8 +75,7 @@ class PairBoard {
 
   // ---- what this agent knows of each map
   /// `agent` announced `version` (not yet held, unless it is ours).
-  /// Returns the estimates held back for this version (estimateSeen) that are
-  /// now stored.
+  /// Returns the estimates held back (estimateSeen) that are now stored.
   std::vector<AgreedTransform> mapAnnounced(const std::string& agent, uint64_t version);
   /// This agent now holds `agent`'s map at its announced version.
   void mapHeld(const std::string& agent);
@@ -93,12 +92,13 @@ class PairBoard {
   // ---- from the network
   void claimSeen(const std::string& claimer, const PairAt& claim, Clock::time_point now);
   /// Whether an estimate from the network was stored. Only an estimate for
-  /// the maps' current versions is: one for a version not announced yet is
-  /// held back (Pending, one per pair and computer) until it is, and stored
-  /// then if it is current; one for other versions is refused (Outdated), so
-  /// a replayed old estimate cannot replace a result. Of two estimates for the
-  /// same versions every agent keeps the one of the higher-ranked computer.
-  enum class Offer { Stored, Duplicate, Outdated, Pending };
+  /// the maps' announced versions is. Any other is held back (Pending, one per
+  /// pair and computer): it may be ahead of an announcement on its way. It is
+  /// stored once both its versions are announced, and dropped once either map
+  /// is announced at another version, so a replayed old estimate never
+  /// replaces a result. Of two estimates for the same versions every agent
+  /// keeps the one of the higher-ranked computer.
+  enum class Offer { Stored, Duplicate, Pending };
   Offer estimateSeen(AgreedTransform t);
   /// A peer's participant is up (again): it can compute the pairs that are its turn.
   void agentUp(const std::string& agent) { up_.insert(agent); }
@@ -176,7 +176,7 @@ class PairBoard {
   std::set<std::string> up_;                                       ///< peers whose participant is up
   /// Since when each held, unsettled pair has gone without a live claim here.
   std::map<PairKey, Clock::time_point> unclaimed_since_;
-  /// Estimates for versions not announced yet, per pair and computer.
+  /// Estimates for versions other than the announced ones, per pair and computer.
   std::map<std::pair<PairKey, std::string>, AgreedTransform> pending_;
   std::optional<PairAt> computing_;
   Clock::time_point claim_renewed_{};  ///< when the computing pair's claim was last published

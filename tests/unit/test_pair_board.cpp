@@ -219,8 +219,10 @@ TEST(PairBoard, AnEstimateForOldMapsDoesNotReplaceOneForNewer) {
   charlie.mapAnnounced("alpha", 1);
   charlie.mapAnnounced("bravo", 3);
   EXPECT_EQ(charlie.estimateSeen(resultOf({kAB, 1, 3}, "bravo")), PairBoard::Offer::Stored);
-  EXPECT_EQ(charlie.estimateSeen(resultOf({kAB, 1, 2}, "alpha")), PairBoard::Offer::Outdated);
+  EXPECT_EQ(charlie.estimateSeen(resultOf({kAB, 1, 2}, "alpha")), PairBoard::Offer::Pending);
   EXPECT_EQ(charlie.results().at(kAB).source_version, 3u);
+  EXPECT_TRUE(charlie.mapAnnounced("bravo", 4).empty()) << "bravo moved on to 4: the estimate for 2 is dropped";
+  EXPECT_TRUE(charlie.mapAnnounced("bravo", 2).empty()) << "and does not come back";
 }
 
 TEST(PairBoard, LeavingTheNetworkVoidsEveryClaim) {
@@ -234,8 +236,38 @@ TEST(PairBoard, AReplayedEstimateForOldMapsIsRefusedEvenWithNoResultHeld) {
   PairBoard charlie("charlie", timings());
   charlie.mapAnnounced("alpha", 1);
   charlie.mapAnnounced("bravo", 3);
-  EXPECT_EQ(charlie.estimateSeen(resultOf({kAB, 1, 2}, "alpha")), PairBoard::Offer::Outdated);
+  EXPECT_EQ(charlie.estimateSeen(resultOf({kAB, 1, 2}, "alpha")), PairBoard::Offer::Pending);
   EXPECT_TRUE(charlie.results().empty());
+  EXPECT_TRUE(charlie.mapAnnounced("alpha", 7).empty());
+  EXPECT_TRUE(charlie.results().empty());
+}
+
+// Seen in the soak run (tests/link/soak.py): bravo's map grew, bravo computed
+// alpha<-bravo for its new version and broadcast it, and the estimate reached
+// charlie a millisecond before bravo's announcement did. Charlie refused it as
+// outdated, everyone else stored it, nobody computed the pair again: charlie
+// held it "stale" for good.
+TEST(PairBoard, AnEstimateForANewVersionAheadOfItsAnnouncementIsStoredWhenTheAnnouncementComes) {
+  PairBoard charlie("charlie", timings());
+  charlie.mapAnnounced("alpha", 1);
+  charlie.mapAnnounced("bravo", 2);
+  ASSERT_EQ(charlie.estimateSeen(resultOf({kAB, 1, 2}, "bravo")), PairBoard::Offer::Stored);
+  EXPECT_EQ(charlie.estimateSeen(resultOf({kAB, 1, 3}, "bravo", 2.0)), PairBoard::Offer::Pending);
+  EXPECT_EQ(charlie.results().at(kAB).source_version, 2u) << "nothing replaced before bravo's 3 is announced";
+  const auto stored = charlie.mapAnnounced("bravo", 3);
+  ASSERT_EQ(stored.size(), 1u);
+  EXPECT_EQ(charlie.results().at(kAB).source_version, 3u);
+  EXPECT_EQ(charlie.status(kAB, t0).state, PairState::Agreed);
+}
+
+TEST(PairBoard, AnEstimateAheadOfBothAnnouncementsWaitsForTheSecond) {
+  PairBoard charlie("charlie", timings());
+  charlie.mapAnnounced("alpha", 1);
+  charlie.mapAnnounced("bravo", 2);
+  EXPECT_EQ(charlie.estimateSeen(resultOf({kAB, 4, 5}, "alpha")), PairBoard::Offer::Pending);
+  EXPECT_TRUE(charlie.mapAnnounced("alpha", 4).empty()) << "bravo's 5 is not here yet";
+  EXPECT_EQ(charlie.mapAnnounced("bravo", 5).size(), 1u);
+  EXPECT_EQ(charlie.results().at(kAB).target_version, 4u);
 }
 
 TEST(PairBoard, AnEstimateAheadOfTheAnnouncementIsHeldUntilItsVersionIsKnown) {
