@@ -7,27 +7,31 @@
 
 namespace tomomap::viz {
 
-cv::Mat drawLogLogPanel(const LinePanel& p, cv::Size size) {
+cv::Mat drawLinePanel(const LinePanel& p, Axes axes, cv::Size size) {
   cv::Mat img(size, CV_8UC3, colour::kWhite);
   const int left = 90, right = size.width - 30, top = 60, bottom = size.height - 60;
+  const bool log = axes == Axes::LogLog;
   std::vector<double> xs, ys;
   for (const auto& s : p.series) {
     xs.insert(xs.end(), s.x.begin(), s.x.end());
     ys.insert(ys.end(), s.y.begin(), s.y.end());
   }
-  const ValueAxis y_axis = ValueAxis::fit(ys, true, top, bottom);
-  // The x axis spans the points with a margin (sizes rarely span decades) and
-  // reuses the row mapping, mirrored: rows grow downwards, columns rightwards.
-  ValueAxis x_axis = ValueAxis::fit(xs, true, left, right);
+  // A linear axis starts at zero (ValueAxis::fit), so growth reads against the whole.
+  const ValueAxis y_axis = ValueAxis::fit(ys, log, top, bottom);
+  // The x axis reuses the row mapping, mirrored: rows grow downwards, columns
+  // rightwards. On a log axis it spans the points with a margin (sizes rarely
+  // span decades).
+  ValueAxis x_axis = ValueAxis::fit(xs, log, left, right);
   std::vector<double> positive;
   for (double x : xs)
     if (x > 0) positive.push_back(x);
-  if (!positive.empty()) {
+  if (log && !positive.empty()) {
     const auto [mn, mx] = std::minmax_element(positive.begin(), positive.end());
     x_axis.lo = *mn / 1.25;
     x_axis.hi = *mx * 1.25;
   }
   const auto column = [&](double x) { return left + right - x_axis.row(x); };
+  const auto shown = [&](double v) { return log ? v > 0 : std::isfinite(v); };
 
   drawText(img, p.title, {size.width / 2, 24}, 0.65, colour::kBlack, Align::Centre, 2);
   for (double t : y_axis.ticks()) {
@@ -35,8 +39,9 @@ cv::Mat drawLogLogPanel(const LinePanel& p, cv::Size size) {
     cv::line(img, {left, y}, {right, y}, colour::kLightGrey, 1);
     drawText(img, tickLabel(t), {left - 8, y + 5}, 0.45, colour::kBlack, Align::Right);
   }
-  for (double t : std::set<double>(xs.begin(), xs.end())) {
-    if (!(t > 0)) continue;
+  const std::vector<double> x_ticks = log ? std::vector<double>(xs.begin(), xs.end()) : x_axis.ticks();
+  for (double t : std::set<double>(x_ticks.begin(), x_ticks.end())) {
+    if (!shown(t)) continue;
     const int x = column(t);
     cv::line(img, {x, top}, {x, bottom}, colour::kLightGrey, 1);
     drawText(img, tickLabel(t), {x, bottom + 20}, 0.45, colour::kBlack, Align::Centre);
@@ -54,9 +59,10 @@ cv::Mat drawLogLogPanel(const LinePanel& p, cv::Size size) {
     lx += 40 + 9 * static_cast<int>(series.name.size());
     std::vector<cv::Point> points;
     for (size_t i = 0; i < series.x.size() && i < series.y.size(); ++i)
-      if (series.x[i] > 0 && series.y[i] > 0) points.emplace_back(column(series.x[i]), y_axis.row(series.y[i]));
+      if (shown(series.x[i]) && shown(series.y[i])) points.emplace_back(column(series.x[i]), y_axis.row(series.y[i]));
     if (points.size() > 1) cv::polylines(img, points, false, c, 2, cv::LINE_AA);
-    for (const auto& q : points) cv::circle(img, q, 4, c, cv::FILLED, cv::LINE_AA);
+    if (points.size() <= 30)  // a long series is its line; markers would hide it
+      for (const auto& q : points) cv::circle(img, q, 4, c, cv::FILLED, cv::LINE_AA);
   }
   return img;
 }

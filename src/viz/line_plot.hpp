@@ -1,6 +1,6 @@
 #pragma once
-// Log-log line plots: a cost against a size, one line per method, where a
-// straight line's slope is the growth exponent.
+// Line plots, one line per series: log-log (a cost against a size, where a
+// straight line's slope is the growth exponent) or linear (a figure over time).
 #include <string>
 #include <vector>
 
@@ -19,8 +19,12 @@ struct LinePanel {
   std::vector<LineSeries> series;
 };
 
-/// Both axes logarithmic; the x values of the points are the x ticks.
-cv::Mat drawLogLogPanel(const LinePanel& panel, cv::Size size = {760, 460});
+enum class Axes {
+  LogLog,  ///< both axes logarithmic; the x values of the points are the x ticks
+  Linear,  ///< both axes linear from zero, 1-2-5 ticks
+};
+
+cv::Mat drawLinePanel(const LinePanel& panel, Axes axes, cv::Size size = {760, 460});
 
 /// The least-squares slope of log y against log x: the exponent of y ~ x^k.
 double logLogSlope(const std::vector<double>& x, const std::vector<double>& y);

@@ -73,7 +73,8 @@ int main(int argc, char** argv) {
   std::snprintf(label, sizeof label, " (slope %.2f)", k_slow);
   slow.name += label;
   viz::writePng(argv[4],
-                viz::drawLogLogPanel(
-                    {"slice-pair matching against map height", "slices per map", "pair matching [s]", {fast, slow}}));
+                viz::drawLinePanel(
+                    {"slice-pair matching against map height", "slices per map", "pair matching [s]", {fast, slow}},
+                    viz::Axes::LogLog));
   return same ? 0 : 1;
 }

@@ -115,6 +115,7 @@ class Relay(threading.Thread):
         self.impairment = impairment
         self.trace = trace  # open file: one line per packet carried, see --trace
         self.fds = {}  # destination IPv4 address (4 bytes) -> TUN fd
+        self.cut = set()  # addresses (4 bytes) whose link is down: nothing to or from them passes
         self.running = True
         self.libc = ctypes.CDLL(None, use_errno=True)
 
@@ -151,7 +152,7 @@ class Relay(threading.Thread):
                 out = self.fds.get(packet[16:20])
                 if out is None:
                     continue
-                dropped = self.impairment.drops(now)
+                dropped = packet[12:16] in self.cut or packet[16:20] in self.cut or self.impairment.drops(now)
                 if self.trace:
                     self.trace.write(f"{now:.3f} {socket.inet_ntoa(packet[12:16])} {socket.inet_ntoa(packet[16:20])} "
                                      f"{describe_packet(packet)}{' dropped' if dropped else ''}\n")
