@@ -4,6 +4,7 @@
 
 #include "agent.hpp"
 #include "core/text.hpp"
+#include "settings.hpp"
 
 namespace tomomap::daemon {
 
@@ -19,14 +20,18 @@ constexpr auto kStatusEvery = std::chrono::seconds(1);
 /// write and close it several times are done by then.
 constexpr auto kMapSettle = std::chrono::milliseconds(1000);
 
-bool sameNetwork(const transport::TransportConfig& a, const transport::TransportConfig& b) {
-  if (a.domain != b.domain || a.address != b.address || a.discovery_port != b.discovery_port ||
-      a.data_port != b.data_port || a.bandwidth_kbps != b.bandwidth_kbps ||
-      a.test_drop_percent != b.test_drop_percent || !(a.security == b.security) || a.peers.size() != b.peers.size())
+/// Whether the network needs no rejoin: no setting that asks for one
+/// changed (settings.hpp declares which do), nor the peers, nor the security
+/// files' contents, nor an injected loss.
+bool sameNetwork(const Config& a, const Config& b) {
+  if (!changed(a, b, Reload::Rejoin).empty() || a.transport.security.contents != b.transport.security.contents ||
+      a.transport.test_drop_percent != b.transport.test_drop_percent ||
+      a.transport.peers.size() != b.transport.peers.size())
     return false;
-  for (size_t i = 0; i < a.peers.size(); ++i)
-    if (a.peers[i].id != b.peers[i].id || a.peers[i].host != b.peers[i].host || a.peers[i].port != b.peers[i].port)
-      return false;
+  for (size_t i = 0; i < a.transport.peers.size(); ++i) {
+    const auto &p = a.transport.peers[i], &q = b.transport.peers[i];
+    if (p.id != q.id || p.host != q.host || p.port != q.port) return false;
+  }
   return true;
 }
 
@@ -103,7 +108,8 @@ void Agent::reload() {
     return;
   }
   // Decided now: a failed join below moves `previous` back into config_.
-  const bool ros2_changed = !(next.ros2 == config_.ros2) || next.treeRoot() != config_.treeRoot();
+  const bool ros2_changed =
+      !changed(next, config_, Reload::RestartsRos2).empty() || next.treeRoot() != config_.treeRoot();
   Config previous = std::move(config_);
   config_ = std::move(next);
   log_.setThreshold(config_.log_level);
@@ -112,7 +118,7 @@ void Agent::reload() {
   peers_.setMemoryBudget(peerMemoryBytes(config_));
   board_.setTimings(boardTimings(config_));
   board_.setFleet(config_.peerIds());
-  if (!sameNetwork(previous.transport, config_.transport)) {
+  if (!sameNetwork(previous, config_)) {
     log_.info("network settings changed: leaving and joining again");
     bus_.reset();
     peers_.clearAlive();

@@ -1,5 +1,6 @@
 #pragma once
-// tomomapd's configuration file (TOML). docs/configuration.md lists every key.
+// tomomapd's configuration file (TOML). Its keys are declared in settings.hpp;
+// docs/configuration.md lists them.
 #include <string>
 #include <vector>
 
@@ -23,10 +24,6 @@ struct Ros2Config {
   std::string map_topic;
 
   std::string frameOf(const std::string& agent) const;
-  bool operator==(const Ros2Config& o) const {
-    return enabled == o.enabled && domain == o.domain && frame == o.frame && root == o.root &&
-           localhost_only == o.localhost_only && map_topic == o.map_topic;
-  }
 };
 
 struct Config {
@@ -65,9 +62,6 @@ struct Config {
 
 /// peer_memory_mb in bytes.
 inline size_t peerMemoryBytes(const Config& c) { return static_cast<size_t>(c.peer_memory_mb * 1e6); }
-
-/// Every key the parser knows, for the reference-docs test.
-const std::vector<std::string>& configKeys();
 
 /// Reads and checks a config. Throws InputError "FILE:LINE:COL: key 'k': problem"
 /// (or "FILE: problem" for a missing file or key).

@@ -15,6 +15,7 @@
 #include "config.hpp"
 #include "core/types.hpp"
 #include "log.hpp"
+#include "settings.hpp"
 #include "version.hpp"
 
 using namespace tomomap::daemon;
@@ -27,12 +28,21 @@ int main(int argc, char** argv) {
   app.set_version_flag("-V,--version", "tomomapd " TOMOMAP_VERSION);
   std::string config_path;
   bool check = false;
-  app.add_option("-c,--config", config_path, "config file (TOML; see docs/configuration.md)")->required();
+  auto* config_option = app.add_option("-c,--config", config_path, "config file (TOML; see docs/configuration.md)");
   app.add_flag("--check", check, "check the config file, print the effective configuration and exit");
+  bool reference = false;
+  app.add_flag("--config-reference", reference,
+               "print every config key (type, default, unit, range, what a reload does, meaning) as a Markdown "
+               "table and exit");
   try {
     app.parse(argc, argv);
+    if (!reference && config_option->empty()) throw CLI::RequiredError("--config");
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (reference) {
+    std::cout << referenceTable();
+    return 0;
   }
 
   Log log;

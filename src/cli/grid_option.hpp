@@ -4,16 +4,20 @@
 #include <cmath>
 #include <string>
 
+#include "core/match_settings.hpp"
+
 namespace tomomap::cli {
 
-/// A positive, finite number of metres; the refusal says what is expected
-/// (CLI11's own PositiveNumber prints its range up to the largest double).
+/// A number of metres in the grid setting's range (match_settings.hpp); the
+/// refusal says what is expected.
 inline CLI::Validator gridSize() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
+        const MatchSetting& grid = matchSetting("grid");
         double v = 0;
-        if (!CLI::detail::lexical_cast(text, v) || !(v > 0) || !std::isfinite(v))
-          return "grid size must be a positive number of metres (0.05 indoors, 0.2-0.5 outdoors), not " + text;
+        if (!CLI::detail::lexical_cast(text, v) || !grid.inRange(v))
+          return "grid size must be a number of metres from " + settingText(grid.lo) + " to " + settingText(grid.hi) +
+                 " (0.05 indoors, 0.2-0.5 outdoors), not " + text;
         return {};
       },
       "METRES");

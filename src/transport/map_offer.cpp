@@ -9,6 +9,7 @@
 
 #include "bundling.hpp"
 #include "core/dense_search.hpp"
+#include "core/match_settings.hpp"
 #include "slice_encoding.hpp"
 
 namespace tomomap::transport {
@@ -23,9 +24,14 @@ size_t sampleHeaderBytes(const std::string& agent) {
   empty.agent(agent);
   return wire::SliceFeatures::getCdrSerializedSize(empty) + 3;
 }
-/// Feature settings outside these are refused: a receiver would otherwise run
-/// ORB with whatever a peer names.
-constexpr int kMaxFeaturesCap = 10000, kMaxPad = 256;
+/// Feature settings outside the settings' ranges are refused: a receiver
+/// would otherwise run ORB with whatever a peer names.
+constexpr int kMaxPad = 256;
+bool acceptable(const wire::FeatureSettings& fs) {
+  static const MatchSetting& features = matchSetting("max_features");
+  static const MatchSetting& fast = matchSetting("fast_threshold");
+  return features.inRange(fs.max_features()) && fast.inRange(fs.fast_threshold()) && fs.pad() <= kMaxPad;
+}
 
 template <typename T>
 std::vector<std::vector<T>> split(const std::vector<T>& items, size_t per_part) {
@@ -147,9 +153,8 @@ void bundleOffer(MapOffer& offer, const wire::MapAnnouncement* previous) {
 std::set<int> unchangedSlices(const wire::MapAnnouncement& now, const wire::MapAnnouncement& then) {
   std::set<int> kept;
   const bool same_raster = now.agent() == then.agent() && now.grid() == then.grid() && now.x_min() == then.x_min() &&
-                           now.y_min() == then.y_min() && now.z_min() == then.z_min() &&
-                           now.width() == then.width() && now.height() == then.height() &&
-                           now.features() == then.features();
+                           now.y_min() == then.y_min() && now.z_min() == then.z_min() && now.width() == then.width() &&
+                           now.height() == then.height() && now.features() == then.features();
   if (!same_raster) return kept;  // every cell index (or feature) means something else now
   std::map<int, const wire::SliceEntry*> before;
   for (const auto& e : then.slices()) before[e.slice()] = &e;
@@ -209,9 +214,7 @@ Rejection validate(const wire::MapAnnouncement& a) {
     return {Reject::BadRaster};
   if (a.slice_count() <= 0 || a.slice_count() > 100000) return {Reject::BadSliceCount};
   const auto& fs = a.features();
-  if (fs.max_features() == 0 || fs.max_features() > kMaxFeaturesCap || fs.fast_threshold() == 0 ||
-      fs.fast_threshold() > 255 || fs.pad() > kMaxPad)
-    return {Reject::BadFeatureSettings};
+  if (!acceptable(fs)) return {Reject::BadFeatureSettings};
   // A slice can never need more than its deflated raster or its announced features.
   const size_t cap = std::max<size_t>(compressBound(static_cast<uLong>(rasterBytes(a.width(), a.height()))),
                                       size_t{fs.max_features()} * kFeatureBytes);

@@ -27,10 +27,6 @@ struct SecurityFiles {
   /// certificate) joins the network again with them.
   size_t contents = 0;
   bool enabled() const { return !ca.empty(); }
-  bool operator==(const SecurityFiles& o) const {
-    return ca == o.ca && certificate == o.certificate && private_key == o.private_key && governance == o.governance &&
-           permissions == o.permissions && crl == o.crl && contents == o.contents;
-  }
 };
 
 struct TransportConfig {

@@ -152,7 +152,9 @@ TEST(Cli, BadGridValues) {
   expectBadInput(runTomomap("match" + maps + " --grid 0"), "--grid");
   expectBadInput(runTomomap("match" + maps + " --grid -0.05"), "--grid");
   expectBadInput(runTomomap("match" + maps + " --grid abc"), "--grid");
-  expectBadInput(runTomomap("match" + maps + " --grid 0.00001"), "too fine");
+  // One range for the grid everywhere (the daemon's `grid` key too).
+  expectBadInput(runTomomap("match" + maps + " --grid 0.00001"), "from 0.005 to 10");
+  expectBadInput(runTomomap("match" + maps + " --grid 50"), "from 0.005 to 10");
 }
 
 TEST(Cli, BadPoseFile) {
@@ -376,7 +378,8 @@ TEST(Cli, QuietIsOneLineJsonGoesToStdoutAndTyposGetASuggestion) {
 
   const auto zero = runTomomap(demoMatchArgs() + " --grid 0");
   EXPECT_EQ(zero.exit_code, 2);
-  EXPECT_NE(zero.output.find("grid size must be a positive number of metres"), std::string::npos) << zero.output;
+  EXPECT_NE(zero.output.find("grid size must be a number of metres from 0.005 to 10"), std::string::npos)
+      << zero.output;
   EXPECT_LT(zero.output.size(), 300u) << zero.output;
 }
 

@@ -8,7 +8,9 @@
 #include <regex>
 
 #include "config.hpp"
+#include "core/match_settings.hpp"
 #include "fleet/fleet_keys.hpp"
+#include "settings.hpp"
 #include "support.hpp"
 
 using namespace tomomap;
@@ -84,7 +86,7 @@ TEST(DaemonConfig, TheMatchTableOverridesTheMatchersDefaults) {
 
   std::string e = errorOf(dir, base + "[match]\nmin_support = 2.5\n");
   EXPECT_NE(e.find("c.toml:6:"), std::string::npos) << e;
-  EXPECT_NE(e.find("'min_support': must be a whole number"), std::string::npos) << e;
+  EXPECT_NE(e.find("'match.min_support': must be a whole number"), std::string::npos) << e;
   e = errorOf(dir, base + "[match]\nransac = 3\n");
   EXPECT_NE(e.find("'match.ransac': unknown key"), std::string::npos) << e;
   e = errorOf(dir, base + "match = 3\n");
@@ -113,7 +115,7 @@ TEST(DaemonConfig, TheRos2TableTurnsTfStaticOnWithFramesAndARootFromTheFleet) {
   EXPECT_NE(e.find("c.toml:9:"), std::string::npos) << e;
   EXPECT_NE(e.find("must contain {agent}"), std::string::npos) << e;
   e = errorOf(dir, base + "[ros2]\nenabled = \"yes\"\n");
-  EXPECT_NE(e.find("'enabled': must be true or false"), std::string::npos) << e;
+  EXPECT_NE(e.find("'ros2.enabled': must be true or false"), std::string::npos) << e;
 }
 
 TEST(DaemonConfig, AMapTopicReplacesTheMapFile) {
@@ -142,37 +144,51 @@ TEST(DaemonConfig, AMapTopicReplacesTheMapFile) {
   EXPECT_NE(e.find("needs [ros2] enabled"), std::string::npos) << e;
 }
 
-TEST(DaemonConfig, EveryKeyIsInTheReference) {
+// The table is made from the settings' declarations (settings.hpp): print it
+// with `tomomapd --config-reference` and paste it over the old one.
+TEST(DaemonConfig, TheReferenceTableIsTheDeclaredSettings) {
   std::ifstream in(std::string(TOMOMAP_SOURCE_DIR) + "/docs/configuration.md");
   const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_FALSE(doc.empty());
-  for (std::string key : configKeys()) {
-    for (const std::string table : {"peer.", "match.", "security.", "ros2."})
-      if (key.rfind(table, 0) == 0) key = key.substr(table.size());
-    EXPECT_NE(doc.find("`" + key + "`"), std::string::npos) << key << " is not in docs/configuration.md";
-  }
+  const std::string table = referenceTable();
+  EXPECT_NE(doc.find(table), std::string::npos) << "docs/configuration.md's table is not this:\n" << table;
+  size_t rows = 0;
+  for (size_t at = doc.find("\n| `"); at != std::string::npos; at = doc.find("\n| `", at + 1)) ++rows;
+  EXPECT_EQ(rows, settings().size()) << "one table row per setting, and no other table of keys";
 }
 
-TEST(DaemonConfig, EveryKeyInTheReferenceIsOneTheDaemonReads) {
-  std::ifstream in(std::string(TOMOMAP_SOURCE_DIR) + "/docs/configuration.md");
-  std::string line;
-  size_t rows = 0;
-  const std::regex row(R"(^\| (`\[\[peer\]\]` |`\[match\]` |`\[security\]` |`\[ros2\]` )?`([a-z_]+)` \|)");
-  while (std::getline(in, line)) {
-    std::smatch m;
-    if (!std::regex_search(line, m, row)) continue;
-    ++rows;
-    const std::string prefix = m[1].str();
-    const std::string table = !m[1].matched                                  ? ""
-                              : prefix.find("peer") != std::string::npos     ? "peer."
-                              : prefix.find("security") != std::string::npos ? "security."
-                              : prefix.find("ros2") != std::string::npos     ? "ros2."
-                                                                             : "match.";
-    const std::string key = table + m[2].str();
-    const auto& keys = configKeys();
-    EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end()) << key << " is documented but not read";
+TEST(DaemonConfig, ARangeIsOneRangeEverywhere) {
+  // The daemon's [match] keys are the matcher's settings, with their ranges.
+  for (const MatchSetting& m : matchSettings()) {
+    const Setting& s = setting(m.key == "grid" ? "grid" : "match." + m.key);
+    EXPECT_EQ(s.lo, m.lo) << s.key;
+    EXPECT_EQ(s.hi, m.hi) << s.key;
+    EXPECT_EQ(s.kind, m.kind) << s.key;
   }
-  EXPECT_EQ(rows, configKeys().size()) << "one table row per key";
+  TempDir dir;
+  const std::string base = "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n[match]\n";
+  EXPECT_NE(errorOf(dir, base + "max_features = 10001\n").find("must be a number from 1 to 10000"), std::string::npos);
+  EXPECT_EQ(errorOf(dir, base + "threads = 1024\n"), "");
+}
+
+TEST(DaemonConfig, AReloadRejoinsForEveryNetworkSettingAndOnlyThose) {
+  TempDir dir;
+  const std::string base = "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n";
+  std::ofstream(dir / "c.toml") << base;
+  const Config before = loadConfig(dir / "c.toml");
+  std::ofstream(dir / "c.toml") << base << "bandwidth_kbps = 500\nclaim_timeout_s = 9\n[ros2]\ndomain = 3\n";
+  const Config after = loadConfig(dir / "c.toml");
+  EXPECT_EQ(changed(before, after, Reload::Rejoin), std::vector<std::string>{"bandwidth_kbps"});
+  EXPECT_EQ(changed(before, after, Reload::AtOnce), std::vector<std::string>{"claim_timeout_s"});
+  EXPECT_EQ(changed(before, after, Reload::RestartsRos2), (std::vector<std::string>{"ros2.enabled", "ros2.domain"}));
+  // Every setting says what a reload does with it, and a field of the
+  // transport is one a rejoin follows (no field compared by hand).
+  for (const Setting& s : settings()) {
+    if (s.key.rfind("peer.", 0) == 0 || s.key.rfind("security.", 0) == 0 || s.key == "domain" || s.key == "address" ||
+        s.key.find("_port") != std::string::npos || s.key == "bandwidth_kbps") {
+      EXPECT_EQ(s.reload, Reload::Rejoin) << s.key;
+    }
+  }
 }
 
 TEST(DaemonConfig, EveryShippedConfigLoads) {
@@ -207,7 +223,7 @@ TEST(DaemonConfig, SecurityFilesMustExistAndBeComplete) {
             std::string::npos)
       << errorOf(dir, base + "ca = \"nope.pem\"\n");
   std::ofstream(dir / "ca.pem") << "x";
-  EXPECT_NE(errorOf(dir, base + "ca = \"ca.pem\"\n").find("key 'certificate' is required"), std::string::npos)
+  EXPECT_NE(errorOf(dir, base + "ca = \"ca.pem\"\n").find("key 'security.certificate' is required"), std::string::npos)
       << errorOf(dir, base + "ca = \"ca.pem\"\n");
   EXPECT_NE(errorOf(dir, base + "cert = \"ca.pem\"\n").find("key 'security.cert': unknown key"), std::string::npos);
 }

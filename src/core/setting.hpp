@@ -1,0 +1,44 @@
+#pragma once
+// A user-facing setting of a struct S, declared once: its key, kind, unit,
+// range and meaning, and how to read and write its field. The config file
+// reader, the effective-config printout, the reference docs and the command
+// line options are driven from these declarations (match_settings.hpp,
+// daemon/settings.hpp), so a range or a unit cannot differ between them.
+#include <functional>
+#include <sstream>
+#include <string>
+#include <variant>
+
+namespace tomomap {
+
+/// A setting's value as a config file or command line gives it.
+using SettingValue = std::variant<bool, double, std::string>;
+
+enum class SettingKind { Flag, Integer, Number, Text };
+
+template <typename S>
+struct SettingOf {
+  std::string key;
+  SettingKind kind = SettingKind::Number;
+  std::string unit;       ///< "m", "s", "grid cells", ... (empty: none)
+  double lo = 0, hi = 0;  ///< Integer and Number: the accepted range, both ends included
+  std::string doc;        ///< what it does, one paragraph
+  std::function<SettingValue(const S&)> get;
+  std::function<void(S&, const SettingValue&)> set;
+
+  bool hasRange() const { return kind == SettingKind::Integer || kind == SettingKind::Number; }
+  bool inRange(double v) const { return v >= lo && v <= hi; }
+};
+
+/// "true", "0.05", "1000", or the text itself.
+inline std::string settingText(const SettingValue& v) {
+  if (const bool* b = std::get_if<bool>(&v)) return *b ? "true" : "false";
+  if (const double* d = std::get_if<double>(&v)) {
+    std::ostringstream o;
+    o << *d;
+    return o.str();
+  }
+  return std::get<std::string>(v);
+}
+
+}  // namespace tomomap
