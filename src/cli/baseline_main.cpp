@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
   app.add_option("--gt-source", gt_source, "source's ground-truth pose file (3x4 row-major)");
   app.add_option("-j,--threads", p.threads, "worker threads (0 = all cores)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 1024));
+      ->check(settingRange("threads"));
   return parseAndRun(app, argc, argv, [&] {
     requireBothOrNeither(gt_target, gt_source);
     std::optional<Eigen::Matrix4d> P_target, P_source;

@@ -15,6 +15,7 @@
 #include "commands.hpp"
 #include "core/stats.hpp"
 #include "exit_codes.hpp"
+#include "grid_option.hpp"
 #include "io/map_io.hpp"
 #include "results/json_schema.hpp"
 #include "suite.hpp"
@@ -314,7 +315,7 @@ Command addEvalCommand(CLI::App& app) {
       ->check(CLI::IsMember(kEvalMethods));
   sub->add_option("-j,--threads", o->threads, "threads per match (0 = all cores)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 1024));
+      ->check(settingRange("threads"));
   sub->add_option("--timeout", o->timeout_s,
                   "seconds one run may take; then it is killed and its row says so (0 = none)")
       ->capture_default_str()

@@ -1,5 +1,7 @@
 #pragma once
-// The check of a --grid option, shared by tomomap and tomomap-baseline.
+// Checks of the options that are matcher settings (--grid, --features,
+// --threads, --max-tilt), shared by tomomap and tomomap-baseline: the
+// settings' own ranges (core/match_settings.hpp), as in the daemon's config.
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <string>
@@ -21,6 +23,12 @@ inline CLI::Validator gridSize() {
         return {};
       },
       "METRES");
+}
+
+/// The range of the matcher setting `key` ("threads", "max_features", ...).
+inline CLI::Range settingRange(const char* key) {
+  const MatchSetting& s = matchSetting(key);
+  return CLI::Range(s.lo, s.hi);
 }
 
 }  // namespace tomomap::cli

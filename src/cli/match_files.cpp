@@ -5,7 +5,6 @@
 #include <iostream>
 
 #include "core/map_bounds.hpp"
-#include "core/match_settings.hpp"
 #include "core/text.hpp"
 #include "grid_option.hpp"
 #include "io/map_io.hpp"
@@ -63,20 +62,15 @@ void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
                  "also write the result as JSON to FILE (- for stdout; the text then goes to stderr)");
   sub.add_option("--gt-target", o.gt_target, "target's ground-truth pose file (3x4 row-major)");
   sub.add_option("--gt-source", o.gt_source, "source's ground-truth pose file (3x4 row-major)");
-  // The ranges are the settings' own (match_settings.hpp), as in the daemon's [match] table.
-  const auto range = [](const char* key) {
-    const MatchSetting& s = matchSetting(key);
-    return CLI::Range(s.lo, s.hi);
-  };
   sub.add_option("--features", o.params.features.max_features, "ORB keypoints kept per slice")
       ->capture_default_str()
-      ->check(range("max_features"));
+      ->check(settingRange("max_features"));
   sub.add_option("-j,--threads", o.params.threads, "worker threads (0 = all cores)")
       ->capture_default_str()
-      ->check(range("threads"));
+      ->check(settingRange("threads"));
   sub.add_option("--max-tilt", o.max_tilt_deg, "level (or refuse) a map tilted more than this from gravity [deg]")
       ->capture_default_str()
-      ->check(range("max_tilt_deg"));
+      ->check(settingRange("max_tilt_deg"));
   sub.add_flag("--level,!--no-level", o.params.level,
                "level a map tilted beyond --max-tilt (turn its up onto z; on by default); --no-level refuses it");
   sub.add_flag("--exhaustive", o.params.exhaustive,
