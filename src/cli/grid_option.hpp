@@ -28,6 +28,7 @@ inline CLI::Validator gridSize() {
 /// The range of the matcher setting `key` ("threads", "max_features", ...).
 inline CLI::Range settingRange(const char* key) {
   const MatchSetting& s = matchSetting(key);
+  if (s.kind == SettingKind::Integer) return CLI::Range(static_cast<int>(s.lo), static_cast<int>(s.hi));
   return CLI::Range(s.lo, s.hi);
 }
 
