@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <utility>
 
 #include "core/text.hpp"
 #include "results/agreed_transform.hpp"
@@ -25,16 +26,16 @@ constexpr auto kAnnouncementWait = std::chrono::seconds(5);
 
 }  // namespace
 
-wire::ChunkRequest PeerMaps::requestFor(const std::string& owner, const Peer& p, bool everything,
+wire::ChunkRequest PeerMaps::requestFor(const std::string& id, const PeerState& owner, bool everything,
                                         Clock::time_point now) const {
+  const Peer& p = owner.map;
   wire::ChunkRequest r;
   r.requester(me_);
-  r.owner(owner);
+  r.owner(id);
   r.version(p.incoming->announcement().version());
   const auto quiet = std::chrono::duration_cast<std::chrono::milliseconds>(now - p.last_progress).count();
   r.stalled_ms(static_cast<uint32_t>(std::clamp<int64_t>(quiet, 0, UINT32_MAX)));
-  const auto through = received_through_.find(owner);
-  r.received_through(through == received_through_.end() ? 0 : through->second);
+  r.received_through(owner.received_through);
   if (everything) return r;  // an empty list asks for every announced slice
   // Listed only once some slice is in: until then the empty list says the
   // same in 4 bytes a slice less (and the request reaches every receiver).
@@ -45,8 +46,9 @@ wire::ChunkRequest PeerMaps::requestFor(const std::string& owner, const Peer& p,
 
 PeerMaps::Announced PeerMaps::announce(wire::MapAnnouncement a, Clock::time_point now) {
   const std::string owner = a.agent().to_string();
-  unannounced_.erase(owner);
-  Peer& p = peers_[owner];
+  PeerState& state = peers_[owner];
+  state.unannounced.reset();
+  Peer& p = state.map;
   if (p.incoming && p.incoming->announcement().version() == a.version()) return {};  // already known
   std::optional<transport::Reassembler> earlier = std::move(p.incoming);
   p = Peer{};
@@ -60,20 +62,19 @@ PeerMaps::Announced PeerMaps::announce(wire::MapAnnouncement a, Clock::time_poin
                            versionText(earlier->announcement().version())
                      : ""));
   p.last_progress = p.requested = p.last_request = now;
-  const size_t early = takeEarly(owner, p, now);
+  const size_t early = takeEarly(owner, state, now);
   Announced out{true, false, std::nullopt};
   if (p.incoming->complete()) {
-    complete(owner, p);
+    complete(owner, state);
     out.complete = true;
   } else {
-    out.request = requestFor(owner, p, /*everything=*/p.reused == 0 && early == 0, now);
+    out.request = requestFor(owner, state, /*everything=*/p.reused == 0 && early == 0, now);
   }
   return out;
 }
 
-void PeerMaps::noteTaken(const std::string& owner, uint64_t sequence) {
-  uint64_t& through = received_through_[owner];
-  through = std::max(through, sequence);
+void PeerMaps::noteTaken(PeerState& owner, uint64_t sequence) {
+  owner.received_through = std::max(owner.received_through, sequence);
 }
 
 bool PeerMaps::tally(Peer& p, size_t bytes, Clock::time_point now) {
@@ -85,58 +86,59 @@ bool PeerMaps::tally(Peer& p, size_t bytes, Clock::time_point now) {
   return first;
 }
 
-void PeerMaps::holdEarly(const std::string& owner, const wire::SliceFeatures& s, size_t bytes, uint64_t sequence,
-                         Clock::time_point now) {
-  Early& e = early_[owner];
+void PeerMaps::holdEarly(PeerState& owner, const wire::SliceFeatures& s, size_t bytes, uint64_t sequence,
+                         Clock::time_point now) const {
+  Early& e = owner.early;
   if (e.version != s.version() || now - e.since > kEarlyHold) e = Early{s.version(), now, {}, 0};  // one version, fresh
   if (e.bytes + bytes > memory_budget_) return;  // the owner's budget holds for these too
   e.samples.push_back({s, bytes, sequence});
   e.bytes += bytes;
 }
 
-size_t PeerMaps::takeEarly(const std::string& owner, Peer& p, Clock::time_point now) {
-  const auto it = early_.find(owner);
-  if (it == early_.end() || it->second.version != p.incoming->announcement().version()) return 0;
+size_t PeerMaps::takeEarly(const std::string& id, PeerState& owner, Clock::time_point now) {
+  Peer& p = owner.map;
+  if (owner.early.samples.empty() || owner.early.version != p.incoming->announcement().version()) return 0;
+  const Early held = std::exchange(owner.early, Early{});
   size_t taken = 0;
-  for (const auto& [s, bytes, sequence] : it->second.samples) {
+  for (const auto& [s, bytes, sequence] : held.samples) {
     noteTaken(owner, sequence);
     if (p.incoming->accept(s)) continue;  // checked as any sample is: a bad one is simply not taken
     tally(p, bytes, now);
     ++taken;
   }
-  early_.erase(it);
-  if (taken) log_.debug(owner + ": " + std::to_string(taken) + " samples had arrived before the announcement");
+  if (taken) log_.debug(id + ": " + std::to_string(taken) + " samples had arrived before the announcement");
   return taken;
 }
 
 PeerMaps::Received PeerMaps::receive(const wire::SliceFeatures& s, size_t bytes, uint64_t sequence,
                                      Clock::time_point now) {
-  const std::string owner = s.agent().to_string();
-  const auto it = peers_.find(owner);
-  if (it == peers_.end() || !it->second.incoming || it->second.incoming->announcement().version() != s.version()) {
+  const std::string id = s.agent().to_string();
+  PeerState& owner = peers_[id];
+  Peer& p = owner.map;
+  if (!p.incoming || p.incoming->announcement().version() != s.version()) {
     holdEarly(owner, s, bytes, sequence, now);  // its announcement may still be on the way
     return {};
   }
   noteTaken(owner, sequence);
-  Peer& p = it->second;
   if (p.features) return {};  // complete already: a resend meant for another peer
   Received out;
   if ((out.rejection = p.incoming->accept(s))) return out;
   out.first = tally(p, bytes, now);
   if (p.incoming->complete()) {
-    complete(it->first, p);
+    complete(id, owner);
     out.completed = true;
   }
   return out;
 }
 
-void PeerMaps::complete(const std::string& owner, Peer& p) {
+void PeerMaps::complete(const std::string& id, PeerState& owner) {
+  Peer& p = owner.map;
   p.features = std::make_shared<MapFeatures>(p.incoming->build());
   const double span = p.samples ? seconds(p.last_slice - p.requested) : 0;
-  auto& history = transfers_[owner];
+  auto& history = owner.transfers;
   history.push_back({p.incoming->announcement().version(), p.incoming->sliceCount(), p.reused, p.bytes, span});
   if (history.size() > kTransfersKept) history.pop_front();
-  log_.info("received the map of " + owner + ": " + std::to_string(p.incoming->sliceCount()) + " slices (" +
+  log_.info("received the map of " + id + ": " + std::to_string(p.incoming->sliceCount()) + " slices (" +
             std::to_string(p.reused) + " kept from the previous version), " + std::to_string(p.bytes) + " bytes in " +
             std::to_string(p.samples) + " samples, " + fixed(span, 2) + " s after our request (" +
             fixed(rateKbps(p), 0) + " kbit/s while sending)");
@@ -144,29 +146,33 @@ void PeerMaps::complete(const std::string& owner, Peer& p) {
 
 bool PeerMaps::waiting(const Peer& p) { return p.incoming && !p.features && !p.incoming->refused(); }
 
-wire::ChunkRequest PeerMaps::askAgain(const std::string& owner, Peer& p, Clock::time_point now) {
-  wire::ChunkRequest r = requestFor(owner, p, /*everything=*/false, now);
+wire::ChunkRequest PeerMaps::askAgain(const std::string& id, PeerState& owner, Clock::time_point now) {
+  Peer& p = owner.map;
+  wire::ChunkRequest r = requestFor(id, owner, /*everything=*/false, now);
   p.last_request = now;
   ++p.unanswered;
   const size_t wanted = r.slices().empty() ? p.incoming->sliceCount() : r.slices().size();
-  log_.info("asked " + owner + " again for " + std::to_string(wanted) + " missing slices");
+  log_.info("asked " + id + " again for " + std::to_string(wanted) + " missing slices");
   return r;
 }
 
 std::vector<wire::ChunkRequest> PeerMaps::due(Clock::duration interval, Clock::time_point now) {
   std::vector<wire::ChunkRequest> out;
-  for (auto& [id, p] : peers_) {
-    if (!waiting(p)) continue;
-    const auto quiet_since = std::max(p.last_progress, p.last_request);
-    if (now - quiet_since < interval * (1 << std::min(p.unanswered, kMaxBackoffDoublings))) continue;
-    out.push_back(askAgain(id, p, now));
-  }
-  for (const auto& id : alive_) {
-    const auto held = peers_.find(id);
-    if (held != peers_.end() && held->second.incoming) continue;
-    const auto [it, first] = unannounced_.try_emplace(id, Unannounced{now, 0});
-    Unannounced& u = it->second;
-    if (first || now - u.since < kAnnouncementWait * (1 << std::min(u.asked, kMaxBackoffDoublings))) continue;
+  for (auto& [id, owner] : peers_) {
+    const Peer& p = owner.map;
+    if (waiting(p)) {
+      const auto quiet_since = std::max(p.last_progress, p.last_request);
+      if (now - quiet_since >= interval * (1 << std::min(p.unanswered, kMaxBackoffDoublings)))
+        out.push_back(askAgain(id, owner, now));
+      continue;
+    }
+    if (!owner.alive || p.incoming) continue;
+    if (!owner.unannounced) {
+      owner.unannounced = Unannounced{now, 0};
+      continue;
+    }
+    Unannounced& u = *owner.unannounced;
+    if (now - u.since < kAnnouncementWait * (1 << std::min(u.asked, kMaxBackoffDoublings))) continue;
     u.since = now;
     ++u.asked;
     wire::ChunkRequest r;
@@ -181,30 +187,52 @@ std::vector<wire::ChunkRequest> PeerMaps::due(Clock::duration interval, Clock::t
 
 std::optional<wire::ChunkRequest> PeerMaps::askNow(const std::string& owner, Clock::time_point now) {
   const auto it = peers_.find(owner);
-  if (it == peers_.end() || !waiting(it->second)) return std::nullopt;
+  if (it == peers_.end() || !waiting(it->second.map)) return std::nullopt;
   return askAgain(owner, it->second, now);
 }
 
 std::shared_ptr<const MapFeatures> PeerMaps::features(const std::string& peer) const {
   const auto it = peers_.find(peer);
-  return it == peers_.end() ? nullptr : it->second.features;
+  return it == peers_.end() ? nullptr : it->second.map.features;
 }
 
 std::optional<uint64_t> PeerMaps::version(const std::string& peer) const {
   const auto it = peers_.find(peer);
-  if (it == peers_.end() || !it->second.incoming) return std::nullopt;
-  return it->second.incoming->announcement().version();
+  if (it == peers_.end() || !it->second.map.incoming) return std::nullopt;
+  return it->second.map.incoming->announcement().version();
 }
 
 bool PeerMaps::setAlive(const std::string& peer, bool alive) {
-  received_through_.erase(peer);
-  unannounced_.erase(peer);
-  return alive ? alive_.insert(peer).second : alive_.erase(peer) > 0;
+  PeerState& state = peers_[peer];
+  state.received_through = 0;
+  state.unannounced.reset();
+  return std::exchange(state.alive, alive) != alive;
+}
+
+void PeerMaps::clearAlive() {
+  for (auto& [id, state] : peers_) {
+    state.alive = false;
+    state.received_through = 0;
+    state.unannounced.reset();
+  }
+}
+
+size_t PeerMaps::aliveCount() const {
+  return static_cast<size_t>(
+      std::count_if(peers_.begin(), peers_.end(), [](const auto& entry) { return entry.second.alive; }));
+}
+
+std::set<std::string> PeerMaps::alive() const {
+  std::set<std::string> ids;
+  for (const auto& [id, state] : peers_)
+    if (state.alive) ids.insert(id);
+  return ids;
 }
 
 PeerMaps::Totals PeerMaps::totals() const {
   Totals t;
-  for (const auto& [id, p] : peers_) {
+  for (const auto& [id, state] : peers_) {
+    const Peer& p = state.map;
     if (!p.incoming) continue;
     t.maps += p.features != nullptr;
     t.slices_done += p.incoming->slicesDone();
@@ -220,11 +248,12 @@ double PeerMaps::rateKbps(const Peer& p) {
 }
 
 nlohmann::json PeerMaps::status(const transport::PeerAddress& peer) const {
-  nlohmann::json j{{"alive", alive_.count(peer.id) > 0}, {"host", peer.host}, {"port", peer.port}};
-  if (const auto seen = last_seen_ms_.find(peer.id); seen != last_seen_ms_.end()) j["last_seen_ms"] = seen->second;
   const auto it = peers_.find(peer.id);
-  if (it != peers_.end() && it->second.incoming) {
-    const Peer& p = it->second;
+  const PeerState none;
+  const PeerState& state = it == peers_.end() ? none : it->second;
+  nlohmann::json j{{"alive", state.alive}, {"host", peer.host}, {"port", peer.port}};
+  if (state.last_seen_ms) j["last_seen_ms"] = *state.last_seen_ms;
+  if (const Peer& p = state.map; p.incoming) {
     j["version"] = versionText(p.incoming->announcement().version());
     j["slices_received"] = p.incoming->slicesDone();
     j["slices_total"] = p.incoming->sliceCount();
@@ -236,13 +265,12 @@ nlohmann::json PeerMaps::status(const transport::PeerAddress& peer) const {
     j["rate_kbps"] = rateKbps(p);
   }
   nlohmann::json history = nlohmann::json::array();
-  if (const auto t = transfers_.find(peer.id); t != transfers_.end())
-    for (const auto& x : t->second)
-      history.push_back({{"version", versionText(x.version)},
-                         {"slices", x.slices},
-                         {"slices_reused", x.reused},
-                         {"bytes", x.bytes},
-                         {"seconds", x.seconds}});
+  for (const auto& x : state.transfers)
+    history.push_back({{"version", versionText(x.version)},
+                       {"slices", x.slices},
+                       {"slices_reused", x.reused},
+                       {"bytes", x.bytes},
+                       {"seconds", x.seconds}});
   j["transfers"] = history;
   return j;
 }

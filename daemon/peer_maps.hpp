@@ -1,7 +1,9 @@
 #pragma once
 // The peers' maps as they arrive: one reassembler per peer at its latest
 // announced version, the requests for what is still missing, and the history
-// of finished transfers. No DDS: requests are returned for the caller to send.
+// of finished transfers. Everything about one peer is one PeerState, so a
+// peer dropped from the config leaves nothing behind. No DDS: requests are
+// returned for the caller to send.
 #include <chrono>
 #include <deque>
 #include <map>
@@ -71,35 +73,18 @@ class PeerMaps {
   /// that changed anything. Either way its writer's sequence numbers start
   /// anew (a restarted peer has a new participant).
   bool setAlive(const std::string& peer, bool alive);
-  size_t aliveCount() const { return alive_.size(); }
-  const std::set<std::string>& alive() const { return alive_; }
+  size_t aliveCount() const;
+  std::set<std::string> alive() const;
   /// A sample from `peer` arrived (wall time, for status).
-  void seen(const std::string& peer, uint64_t wall_ms) { last_seen_ms_[peer] = wall_ms; }
+  void seen(const std::string& peer, uint64_t wall_ms) { peers_[peer].last_seen_ms = wall_ms; }
   /// Drops everything about every peer `keep` rejects (a reload removed it
-  /// from the config): its map, held samples, stream position, transfers,
-  /// liveness and last sighting.
+  /// from the config): its PeerState, whole.
   template <typename Keep>
   void retain(Keep keep) {
-    const auto pruneMap = [&](auto& byPeer) {
-      for (auto it = byPeer.begin(); it != byPeer.end();) it = keep(it->first) ? std::next(it) : byPeer.erase(it);
-    };
-    const auto prune = [&](std::set<std::string>& ids) {
-      for (auto it = ids.begin(); it != ids.end();) it = keep(*it) ? std::next(it) : ids.erase(it);
-    };
-    pruneMap(peers_);
-    pruneMap(early_);
-    pruneMap(received_through_);
-    pruneMap(unannounced_);
-    pruneMap(transfers_);
-    pruneMap(last_seen_ms_);
-    prune(alive_);
+    for (auto it = peers_.begin(); it != peers_.end();) it = keep(it->first) ? std::next(it) : peers_.erase(it);
   }
   /// Every peer gone (this agent left the network): sequence numbers start anew too.
-  void clearAlive() {
-    alive_.clear();
-    received_through_.clear();
-    unannounced_.clear();
-  }
+  void clearAlive();
 
   /// Progress over every peer: maps complete, slices received and announced.
   struct Totals {
@@ -110,6 +95,7 @@ class PeerMaps {
   nlohmann::json status(const transport::PeerAddress& peer) const;
 
  private:
+  /// The transfer of a peer's latest announced version.
   struct Peer {
     std::optional<transport::Reassembler> incoming;  ///< the latest announced version
     std::shared_ptr<const MapFeatures> features;     ///< once complete
@@ -142,22 +128,42 @@ class PeerMaps {
     std::vector<Held> samples;
     size_t bytes = 0;
   };
-  /// `owner`'s sample numbered `sequence` was taken in (received_through_).
-  void noteTaken(const std::string& owner, uint64_t sequence);
+  /// Live peers whose announcement has not come: since when (or since the
+  /// last ask), and how many times asked.
+  struct Unannounced {
+    Clock::time_point since{};
+    int asked = 0;
+  };
+  /// Everything this agent knows of one peer.
+  struct PeerState {
+    Peer map;  ///< its latest announced version, as it arrives
+    Early early;
+    /// The highest sequence number of its slice writer among the samples
+    /// taken in (wire::ChunkRequest::received_through); 0: none since its
+    /// participant appeared.
+    uint64_t received_through = 0;
+    std::deque<Transfer> transfers;  ///< finished transfers, latest last
+    bool alive = false;
+    std::optional<Unannounced> unannounced;  ///< while alive and its announcement has not come
+    std::optional<uint64_t> last_seen_ms;
+  };
+  /// A sample numbered `sequence` of `owner`'s stream was taken in.
+  static void noteTaken(PeerState& owner, uint64_t sequence);
   /// Counts an accepted sample of `bytes` as progress; returns whether it is the version's first.
   static bool tally(Peer& p, size_t bytes, Clock::time_point now);
   /// Holds a sample of an unannounced version of `owner`'s map.
-  void holdEarly(const std::string& owner, const wire::SliceFeatures& s, size_t bytes, uint64_t sequence,
-                 Clock::time_point now);
+  void holdEarly(PeerState& owner, const wire::SliceFeatures& s, size_t bytes, uint64_t sequence,
+                 Clock::time_point now) const;
   /// Takes in the held samples of the version just announced; returns how many.
-  size_t takeEarly(const std::string& owner, Peer& p, Clock::time_point now);
+  size_t takeEarly(const std::string& id, PeerState& owner, Clock::time_point now);
   /// Builds a peer's map once every slice is in, and records the transfer.
-  void complete(const std::string& owner, Peer& p);
-  wire::ChunkRequest requestFor(const std::string& owner, const Peer& p, bool everything, Clock::time_point now) const;
+  void complete(const std::string& id, PeerState& owner);
+  wire::ChunkRequest requestFor(const std::string& id, const PeerState& owner, bool everything,
+                                Clock::time_point now) const;
   /// Whether `p`'s map is announced, still incomplete, and not refused.
   static bool waiting(const Peer& p);
   /// The request for what `p` still lacks, counted as unanswered until progress.
-  wire::ChunkRequest askAgain(const std::string& owner, Peer& p, Clock::time_point now);
+  wire::ChunkRequest askAgain(const std::string& id, PeerState& owner, Clock::time_point now);
   /// Transfer rate so far [kbit/s]: bytes over the flow-control periods they
   /// took (the first period's budget leaves at once, so the time from the first
   /// to the last sample is one period short).
@@ -166,21 +172,7 @@ class PeerMaps {
   std::string me_;
   const Log& log_;
   size_t memory_budget_;
-  std::map<std::string, Peer> peers_;
-  std::map<std::string, Early> early_;
-  /// Per owner, the highest sequence number of its slice writer among the
-  /// samples taken in (wire::ChunkRequest::received_through).
-  std::map<std::string, uint64_t> received_through_;
-  std::map<std::string, std::deque<Transfer>> transfers_;  ///< finished transfers per peer, latest last
-  std::set<std::string> alive_;
-  /// Live peers whose announcement has not come: since when (or since the
-  /// last ask), and how many times asked.
-  struct Unannounced {
-    Clock::time_point since{};
-    int asked = 0;
-  };
-  std::map<std::string, Unannounced> unannounced_;
-  std::map<std::string, uint64_t> last_seen_ms_;
+  std::map<std::string, PeerState> peers_;
 };
 
 }  // namespace tomomap::daemon
