@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <regex>
 #include <sstream>
-#include <stdexcept>
 
 #include "core/match_settings.hpp"
 
@@ -305,11 +304,7 @@ const std::vector<Setting>& settings() {
   return all;
 }
 
-const Setting& setting(const std::string& key) {
-  for (const auto& s : settings())
-    if (s.key == key) return s;
-  throw std::logic_error("no setting '" + key + "'");
-}
+const Setting& setting(const std::string& key) { return findSetting(settings(), key); }
 
 std::vector<std::string> changed(const Config& a, const Config& b, Reload reload) {
   std::vector<std::string> keys;

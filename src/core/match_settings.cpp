@@ -1,6 +1,5 @@
 #include "match_settings.hpp"
 
-#include <stdexcept>
 
 #include "types.hpp"
 
@@ -64,10 +63,6 @@ const std::vector<MatchSetting>& matchSettings() {
   return all;
 }
 
-const MatchSetting& matchSetting(const std::string& key) {
-  for (const auto& s : matchSettings())
-    if (s.key == key) return s;
-  throw std::logic_error("no match setting '" + key + "'");
-}
+const MatchSetting& matchSetting(const std::string& key) { return findSetting(matchSettings(), key); }
 
 }  // namespace tomomap

@@ -6,8 +6,10 @@
 // daemon/settings.hpp), so a range or a unit cannot differ between them.
 #include <functional>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <variant>
+#include <vector>
 
 namespace tomomap {
 
@@ -29,6 +31,14 @@ struct SettingOf {
   bool hasRange() const { return kind == SettingKind::Integer || kind == SettingKind::Number; }
   bool inRange(double v) const { return v >= lo && v <= hi; }
 };
+
+/// The setting named `key` among `all` (any type with a `key`); std::logic_error if there is none.
+template <typename Setting>
+const Setting& findSetting(const std::vector<Setting>& all, const std::string& key) {
+  for (const auto& s : all)
+    if (s.key == key) return s;
+  throw std::logic_error("no setting '" + key + "'");
+}
 
 /// "true", "0.05", "1000", or the text itself.
 inline std::string settingText(const SettingValue& v) {
