@@ -113,7 +113,7 @@ void Agent::installOwnMap(OwnMap own) {
   if (bus_) {
     bus_->publish(a);
     reannounce_ = false;  // every peer that asked gets this one
-    persist(false);
+    writeStatus();
   }
 }
 
@@ -166,11 +166,11 @@ void Agent::onAnnouncement(wire::MapAnnouncement&& a) {
   for (const auto& t : board_.mapAnnounced(owner, version)) {
     log_.info("agreed " + pairText(t.pair()) + " from " + t.computed_by + " (held until " + owner +
               "'s map was announced)");
-    persist(true);
+    agreedChanged();
   }
   if (done.complete) {
     board_.mapHeld(owner);
-    persist(false);
+    writeStatus();
   }
   if (done.request) bus_->publish(*done.request);
 }
@@ -187,7 +187,7 @@ bool Agent::sameGrid(const std::string& owner, double grid) {
   if (other_grid_[owner] != why) {
     other_grid_[owner] = why;
     log_.warning(owner + ": " + why);
-    persist(false);
+    writeStatus();
   }
   return false;
 }
@@ -199,7 +199,7 @@ void Agent::onSlice(wire::SliceFeatures&& s, size_t bytes, uint64_t sequence) {
   if (got.rejection) return reject(owner, got.rejection);
   if (got.completed) board_.mapHeld(owner);
   // Status shows a transfer under way at once, not a second later.
-  if (got.first || got.completed) persist(false);
+  if (got.first || got.completed) writeStatus();
 }
 
 void Agent::onRequest(wire::ChunkRequest&& r) {
@@ -241,7 +241,7 @@ void Agent::onEstimate(wire::TransformEstimate&& e) {
   if (board_.estimateSeen(std::move(t)) != PairBoard::Offer::Stored) return;
   log_.info(line);
   logIfKept(pair);
-  persist(true);
+  agreedChanged();
 }
 
 void Agent::logIfKept(const PairKey& pair) {
@@ -324,7 +324,7 @@ void Agent::finishCompute() {
   const PairKey pair = t.pair();
   board_.computed(std::move(t));
   logIfKept(pair);
-  persist(true);
+  agreedChanged();
 }
 
 }  // namespace tomomap::daemon

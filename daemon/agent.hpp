@@ -116,9 +116,12 @@ class Agent {
   std::shared_ptr<const MapFeatures> featuresOf(const std::string& agent) const;
 
   // ---- what it tells its operator (agent_status.cpp) and ROS 2 (agent_ros2.cpp)
-  /// Writes status.json, and transforms.json when they changed or an earlier
-  /// write failed (retried with every status write until it succeeds).
-  void persist(bool transforms_changed);
+  /// The agreed transforms changed: the fleet's outputs follow (FleetOutputs:
+  /// the frame, transforms.json and frame.json, /tf_static), then status.json.
+  void agreedChanged();
+  /// Writes status.json; first retries an output write that failed before
+  /// (`retry_outputs`: each status write retries it until it succeeds).
+  void writeStatus(bool retry_outputs = true);
   /// At start: the transforms this agent stored before (transforms.json).
   void restoreTransforms();
   /// Creates the ROS 2 node when [ros2] asks for it (a failure is logged:

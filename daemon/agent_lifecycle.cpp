@@ -139,7 +139,7 @@ void Agent::reload() {
   if (ros2_changed) startRos2();
   watch_ = config_.ros2.map_topic.empty() ? std::make_unique<MapWatch>(config_.map) : nullptr;
   map_touched_ = Clock::now() - kMapSettle;  // and read the map again now
-  persist(true);
+  agreedChanged();
   notifier_.ready();
 }
 
@@ -164,7 +164,7 @@ void Agent::tick(Clock::time_point& last_announce) {
     if (!sender_.informed(peers_.alive())) bus_->publish(sender_.offer().announcement);
   }
   if (now - last_status_ > kStatusEvery) {
-    persist(false);
+    writeStatus();
     notifier_.status(statusLine());
     last_status_ = now;
   }
@@ -219,7 +219,7 @@ int Agent::run(Signals& signals) {
     log_.error("cannot read the map from ROS 2 topic " + config_.ros2.map_topic + " without a ROS 2 node");
     return 2;
   }
-  persist(true);
+  agreedChanged();
   if (config_.ros2.map_topic.empty()) watch_ = std::make_unique<MapWatch>(config_.map);
   if (watch_ && !watch_->active())
     log_.warning("cannot watch the folder of " + config_.map + " for changes: send SIGHUP after updating the map");
@@ -257,7 +257,7 @@ int Agent::run(Signals& signals) {
   }
   notifier_.stopping();
   log_.info("stopping");
-  persist(true);
+  agreedChanged();
   // A match in progress is abandoned: the result would be recomputed by the
   // fleet. Leave without waiting for it; everything else is flushed.
   worker_.abandon();

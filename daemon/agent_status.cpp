@@ -13,15 +13,16 @@ namespace tomomap::daemon {
 
 namespace fs = std::filesystem;
 
-void Agent::persist(bool transforms_changed) {
+void Agent::agreedChanged() {
+  std::vector<AgreedTransform> agreed;
+  for (const auto& [key, t] : board_.results()) agreed.push_back(t);
+  outputs_.update(std::move(agreed), config_);
+  writeStatus(/*retry_outputs=*/false);
+}
+
+void Agent::writeStatus(bool retry_outputs) {
+  if (retry_outputs) outputs_.retry(config_);
   const fs::path dir(config_.output_dir);
-  if (transforms_changed) {
-    std::vector<AgreedTransform> agreed;
-    for (const auto& [key, t] : board_.results()) agreed.push_back(t);
-    outputs_.update(std::move(agreed), config_);
-  } else {
-    outputs_.retry(config_);
-  }
   try {
     nlohmann::json peers = nlohmann::json::object();
     for (const auto& peer : config_.transport.peers) {
