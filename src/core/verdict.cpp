@@ -45,16 +45,15 @@ constexpr double kPooledAgreement = 1.1;
 std::string featureRefusal(const FeatureEvidence& f, const MatchParams& params) {
   if (!f.missing.empty()) return f.missing;
   if (f.support < params.min_support)
-    return "only " + std::to_string(f.support) + " slice pairs agree (need " + std::to_string(params.min_support) +
-           ")";
+    return "only " + std::to_string(f.support) + " slice pairs agree (need " + std::to_string(params.min_support) + ")";
   if (f.runner_up_support > 0 && (f.support - f.runner_up_support < params.min_support ||
                                   static_cast<double>(f.support) < kClearAhead * f.runner_up_support))
     return "ambiguous: another answer " + std::to_string(f.runner_up_gap) +
            " slices away has almost as much support (" + std::to_string(f.support) + " vs " +
            std::to_string(f.runner_up_support) + " slice pairs)";
   if (f.inliers < static_cast<size_t>(params.min_inliers))
-    return "only " + std::to_string(f.inliers) + " inlier correspondences (need " +
-           std::to_string(params.min_inliers) + ")";
+    return "only " + std::to_string(f.inliers) + " inlier correspondences (need " + std::to_string(params.min_inliers) +
+           ")";
   return "";
 }
 
@@ -62,6 +61,19 @@ std::string featureRefusal(const FeatureEvidence& f, const MatchParams& params) 
 bool leads(const DenseEvidence& d, double by, const MatchParams& params) {
   return d.found && d.lead() >= by && significance(d.best.score(), d.next_score) >= kSignificant &&
          holdsOver(d.best, params.min_support);
+}
+
+/// How a search's best pose measures against leading by `by`: its lead, and
+/// each bar it falls short of (the lead, chance, the slices it holds over), so
+/// that a refusal names what refused it.
+std::string shortfall(const DenseEvidence& d, double by, const MatchParams& params) {
+  std::string out = "lead " + fixed(d.lead(), 2) + "x";
+  if (d.lead() < by) out += ", need " + fixed(by, 2) + "x";
+  const double sigma = significance(d.best.score(), d.next_score);
+  if (sigma < kSignificant) out += "; " + fixed(sigma, 1) + " sigma beyond chance, need " + fixed(kSignificant, 0);
+  if (d.best.support < params.min_support)
+    out += "; over " + std::to_string(d.best.support) + " slices, need " + std::to_string(params.min_support);
+  return out;
 }
 
 /// What keeps a search's best pose from counting however far it leads, if anything.
@@ -91,9 +103,7 @@ double significance(double a, double b) {
   return (a - b) / std::sqrt(std::max(a + b, 1.0));
 }
 
-double DenseEvidence::lead() const {
-  return best.score() <= 0 ? 0 : best.score() / std::max(next_score, 1.0);
-}
+double DenseEvidence::lead() const { return best.score() <= 0 ? 0 : best.score() / std::max(next_score, 1.0); }
 
 Verdict decideMatch(const Evidence& e, const MatchParams& params) {
   if (!e.tilted.empty()) return none(e.tilted);
@@ -128,17 +138,16 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
     // right (0.003-0.105 m off), where the features had led by a few pairs.
     if (clear) return by(Verdict::By::at_grid);
     if (!leads(grid, kDenseOpinion, params))
-      why = "a dense search of the occupancy does not confirm the features' answer (its best pose leads by " +
-            fixed(grid.lead(), 2) + "x with " + std::to_string(grid.best.support) + " slices; need " +
-            fixed(kDenseOpinion, 2) + "x and " + std::to_string(params.min_support) + ")" + contradictionNote(grid);
+      why = "a dense search of the occupancy does not confirm the features' answer (its best pose: " +
+            shortfall(grid, kDenseOpinion, params) + ")" + contradictionNote(grid);
     else
       why = "the features and a dense search of the occupancy disagree (" + fixed(grid.lead(), 2) +
             "x lead for a pose " + fixed(grid.apart, 2) + " m, " + fixed(degrees(grid.apart_yaw), 1) + " deg and " +
             fixed(grid.apart_height, 2) + " m in height away)";
   } else {
     if (clear) return by(Verdict::By::at_grid);
-    why += "; nor did a dense search of the occupancy find a clear pose (lead " + fixed(grid.lead(), 2) +
-           "x, need " + fixed(kDenseLead, 2) + "x)" + contradictionNote(grid);
+    why += "; nor did a dense search of the occupancy find a clear pose (" + shortfall(grid, kDenseLead, params) + ")" +
+           contradictionNote(grid);
   }
 
   // The pooled search answers with a clear pose, or with the grid's where the
@@ -152,8 +161,8 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
   if (leads(pooled, kDenseLead, params)) return by(Verdict::By::pooled);
   if (leads(grid, kDenseOpinion, params) && leads(pooled, kPooledAgreement, params) && e.pooled_at_grid_best)
     return by(Verdict::By::at_grid);
-  return none(why + "; at " + fixed(pooled.cell, 2) + " m cells its best pose leads by " + fixed(pooled.lead(), 2) +
-              "x" + contradictionNote(pooled));
+  return none(why + "; at " + fixed(pooled.cell, 2) +
+              " m cells its best pose: " + shortfall(pooled, kDenseLead, params) + contradictionNote(pooled));
 }
 
 }  // namespace tomomap

@@ -79,10 +79,10 @@ TEST(Verdict, TruthTable) {
   add("too few agreeing slice pairs: the dense search is asked", with(featureAnswer(2)), By::none,
       Needs::search_at_grid);
   add("a weak winner: the dense search is asked", with(featureAnswer(10, 2)), By::none, Needs::search_at_grid);
-  add("two answers within min_support pairs are ambiguous",
-      with(featureAnswer(6, 4), DenseEvidence{}, 0.2), By::none, Needs::nothing, "ambiguous: another answer 12");
-  add("a winner under 1.25x its runner-up is ambiguous", with(featureAnswer(30, 25), DenseEvidence{}, 0.2),
-      By::none, Needs::nothing, "ambiguous");
+  add("two answers within min_support pairs are ambiguous", with(featureAnswer(6, 4), DenseEvidence{}, 0.2), By::none,
+      Needs::nothing, "ambiguous: another answer 12");
+  add("a winner under 1.25x its runner-up is ambiguous", with(featureAnswer(30, 25), DenseEvidence{}, 0.2), By::none,
+      Needs::nothing, "ambiguous");
   add("too few inliers", with(few_inliers, DenseEvidence{}, 0.2), By::none, Needs::nothing,
       "only 10 inlier correspondences (need 20)");
   add("no dense search possible (large map): a weak winner stands", with(featureAnswer(10, 2), DenseEvidence{}),
@@ -100,15 +100,22 @@ TEST(Verdict, TruthTable) {
       "the features and a dense search of the occupancy disagree (1.30x lead for a pose 2.50 m");
   add("a dense search too close to tell (1.1x) does not confirm",
       with(featureAnswer(10, 2), search(landed(1100), 1000, true, 0.2), 0.2), By::none, Needs::nothing,
-      "a dense search of the occupancy does not confirm the features' answer (its best pose leads by 1.10x");
+      "a dense search of the occupancy does not confirm the features' answer (its best pose: lead 1.10x, need 1.20x; "
+      "2.2 "
+      "sigma beyond chance, need 3)");
   add("a lead on a handful of cells is chance: 13 to 7 (1.86x) is no answer",
       with(featureAnswer(1), search(landed(13), 7, false, 0.2), 0.2), By::none, Needs::nothing,
       "only 1 slice pairs agree (need 3); nor did a dense search");
+  add("... and the refusal says which bar refused it: a lead past 1.4x that chance explains",
+      with(featureAnswer(1), search(landed(29), 20, false, 0.2), 0.2), By::none, Needs::nothing,
+      "only 1 slice pairs agree (need 3); nor did a dense search of the occupancy find a clear pose (lead 1.45x; 1.3 "
+      "sigma beyond chance, need 3)");
   add("a dense best pose on too few slices does not answer",
       with(featureAnswer(1), search(landed(2000, 0, 2), 1000, false, 0.2), 0.2), By::none, Needs::nothing,
-      "only 1 slice pairs agree");
-  add("a refused feature match is answered by a clear dense pose",
-      with(featureAnswer(1), search(landed(2000), 1000)), By::at_grid);
+      "only 1 slice pairs agree (need 3); nor did a dense search of the occupancy find a clear pose (lead 2.00x; over "
+      "2 slices, need 3)");
+  add("a refused feature match is answered by a clear dense pose", with(featureAnswer(1), search(landed(2000), 1000)),
+      By::at_grid);
   add("a dense best pose that contradicts the empty space: the features' own landing is asked",
       with(featureAnswer(10, 2), search(landed(1000, 600), 100)), By::none, Needs::features_landed);
 
@@ -118,7 +125,7 @@ TEST(Verdict, TruthTable) {
   Evidence own_fails = with(featureAnswer(10, 2), search(landed(1000, 600), 100), 0.2);
   own_fails.features_landed = landed(7000, 5000);
   add("... and is refused where its own landing contradicts (71 %)", own_fails, By::none, Needs::nothing,
-      "a dense search of the occupancy does not confirm the features' answer (its best pose leads by 0.00x");
+      "a dense search of the occupancy does not confirm the features' answer (its best pose: lead 0.00x, need 1.20x");
 
   Evidence pooled_clear = with(featureAnswer(1), search(landed(1200), 1000), 0.05);
   pooled_clear.pooled = search(landed(900), 300, false, 0.1);
@@ -131,7 +138,7 @@ TEST(Verdict, TruthTable) {
   apart.pooled_at_grid_best = false;
   add("... but not where their best poses differ", apart, By::none, Needs::nothing,
       "only 1 slice pairs agree (need 3); nor did a dense search of the occupancy find a clear pose (lead 1.25x, "
-      "need 1.40x); at 0.10 m cells its best pose leads by 1.15x");
+      "need 1.40x); at 0.10 m cells its best pose: lead 1.15x, need 1.40x");
   Evidence pooled_chance = with(featureAnswer(1), search(landed(74), 59, false, 0.1), 0.1);
   pooled_chance.pooled = search(landed(13), 7, false, 0.2);
   add("a pooled lead on 13 cells against 7 is chance (the real RGB-D room answered 13.9 m off)", pooled_chance,
