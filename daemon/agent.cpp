@@ -47,14 +47,19 @@ OwnMap describeLoaded(const Config& config, OwnMap own, const std::function<Poin
   const auto t0 = Clock::now();
   auto features = [&] {
     const Points map = load(own);  // dropped once described
-    return std::make_shared<MapFeatures>(describeMap(map, config.match, nullptr, &own.cells));
+    const auto loaded = Clock::now();
+    auto described = std::make_shared<MapFeatures>(describeMap(map, config.match, &own.stages, &own.cells));
+    own.stages.load = seconds(loaded - t0);
+    return described;
   }();
   // Peers would match slanted slices: offered nowhere, refused here.
   if (const auto why = tiltRefusal(*features, "own", config.match)) throw InputError(mapSource(config) + ": " + *why);
+  const auto encoding = Clock::now();
   own.offer = transport::makeOffer(
       config.agent(), *features, config.match.features, binaryPcdBytes(own.cells),
       transport::maxSampleBytes(config.transport.bandwidth_kbps, config.transport.security.enabled()));
   own.features = std::move(features);
+  own.encoding = seconds(Clock::now() - encoding);
   own.seconds = seconds(Clock::now() - t0);
   return own;
 }
@@ -109,7 +114,10 @@ void Agent::installOwnMap(OwnMap own) {
       (update ? " (was " + versionText(before) + ")" : "") + "; payload " + std::to_string(offer.payload_bytes) +
       " bytes = " + fixed(100.0 * static_cast<double>(offer.payload_bytes) / static_cast<double>(a.raw_bytes()), 1) +
       " % of the voxel-filtered map's binary PCD (" + std::to_string(a.raw_bytes()) + " bytes); " +
-      tiltText(*own_features_) + "; described in " + fixed(own.seconds, 2) + " s");
+      tiltText(*own_features_) + "; described in " + fixed(own.seconds, 2) + " s (read " +
+      fixed(own.stages.load, 2) + ", voxel filter " + fixed(own.stages.voxel, 2) + ", slices " +
+      fixed(own.stages.slicing, 2) + ", ORB " + fixed(own.stages.features, 2) + ", encoding " + fixed(own.encoding, 2) +
+      ")");
   if (bus_) {
     bus_->publish(a);
     reannounce_ = false;  // every peer that asked gets this one

@@ -43,6 +43,8 @@ struct OwnMap {
   size_t nonfinite = 0;  ///< points with NaN or infinite coordinates, dropped
   std::string note;      ///< how the file was read, when a user should know (loadMap)
   double seconds = 0;    ///< time taken to describe it
+  StageTimings stages;   ///< of which reading (load), voxel filter, slicing and ORB (features)
+  double encoding = 0;   ///< of which the offer: the slices encoded for the wire, the version [s]
   std::string frame_id;  ///< the map message's frame (map from a topic); empty for a file
 };
 

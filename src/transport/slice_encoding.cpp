@@ -13,6 +13,24 @@ void put16(std::vector<uint8_t>& b, uint16_t v) {
   b.push_back(static_cast<uint8_t>(v >> 8));
 }
 
+/// `raster` deflated (zlib format) with `strategy`, and, when `max_chain` > 0,
+/// level 9's search for earlier matches bounded to that many candidates.
+std::vector<uint8_t> deflateWith(const std::vector<uint8_t>& raster, int strategy, int max_chain) {
+  z_stream z{};
+  if (deflateInit2(&z, Z_BEST_COMPRESSION, Z_DEFLATED, 15, 8, strategy) != Z_OK) return {};
+  // Level 9's own tuning (good 32, lazy 258, nice 258), with a shorter chain.
+  if (max_chain > 0) deflateTune(&z, 32, 258, 258, max_chain);
+  std::vector<uint8_t> out(deflateBound(&z, static_cast<uLong>(raster.size())));
+  z.next_in = const_cast<Bytef*>(raster.data());
+  z.avail_in = static_cast<uInt>(raster.size());
+  z.next_out = out.data();
+  z.avail_out = static_cast<uInt>(out.size());
+  const bool done = deflate(&z, Z_FINISH) == Z_STREAM_END;
+  out.resize(z.total_out);
+  deflateEnd(&z);
+  return done ? out : std::vector<uint8_t>{};
+}
+
 }  // namespace
 
 size_t rasterBytes(size_t width, size_t height) { return (width * height + 7) / 8; }
@@ -20,12 +38,16 @@ size_t rasterBytes(size_t width, size_t height) { return (width * height + 7) / 
 std::vector<uint8_t> deflateCells(const std::vector<uint32_t>& cells, int width, int height) {
   std::vector<uint8_t> raster(rasterBytes(static_cast<size_t>(width), static_cast<size_t>(height)), 0);
   for (uint32_t c : cells) raster[c / 8] = static_cast<uint8_t>(raster[c / 8] | (1u << (c % 8)));
-  uLongf size = compressBound(static_cast<uLong>(raster.size()));
-  std::vector<uint8_t> out(size);
-  if (compress2(out.data(), &size, raster.data(), static_cast<uLong>(raster.size()), Z_BEST_COMPRESSION) != Z_OK)
-    return {};
-  out.resize(size);
-  return out;
+  // The smaller of two encodings. Runs of empty bytes are most of a raster,
+  // and matching runs alone (Z_RLE) is 150x faster than level 9's chained
+  // search on the building's 123 slices (0.01 s against 1.5 s) at 1 % more
+  // bytes, and 9 % fewer on the street; level 9 with its chain bounded to 256
+  // is 16 % smaller on demo-room's small rooms, at 0.13 s for the building.
+  // Either stream inflates alike: receivers of any version read it.
+  std::vector<uint8_t> rle = deflateWith(raster, Z_RLE, 0);
+  std::vector<uint8_t> searched = deflateWith(raster, Z_DEFAULT_STRATEGY, 256);
+  if (rle.empty() || (!searched.empty() && searched.size() < rle.size())) return searched;
+  return rle;
 }
 
 std::optional<std::vector<uint32_t>> inflateCells(const std::vector<uint8_t>& bytes, int width, int height,
