@@ -28,7 +28,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("-V,--version", "tomomapd " TOMOMAP_VERSION);
   std::string config_path;
   bool check = false;
-  auto* config_option = app.add_option("-c,--config", config_path, "config file (TOML; see docs/configuration.md)");
+  auto* config_option =
+      app.add_option("-c,--config", config_path, "config file (TOML; see docs/configuration.md); required");
   app.add_flag("--check", check, "check the config file, print the effective configuration and exit");
   bool reference = false;
   app.add_flag("--config-reference", reference,
