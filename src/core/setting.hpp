@@ -4,6 +4,7 @@
 // reader, the effective-config printout, the reference docs and the command
 // line options are driven from these declarations (match_settings.hpp,
 // daemon/settings.hpp), so a range or a unit cannot differ between them.
+#include <cmath>
 #include <functional>
 #include <sstream>
 #include <stdexcept>
@@ -45,7 +46,10 @@ inline std::string settingText(const SettingValue& v) {
   if (const bool* b = std::get_if<bool>(&v)) return *b ? "true" : "false";
   if (const double* d = std::get_if<double>(&v)) {
     std::ostringstream o;
-    o << *d;
+    if (*d == std::floor(*d) && std::abs(*d) < 1e15)
+      o << static_cast<long long>(*d);  // 10000000, not 1e+07
+    else
+      o << *d;
     return o.str();
   }
   return std::get<std::string>(v);
