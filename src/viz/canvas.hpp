@@ -10,8 +10,10 @@ namespace tomomap::viz {
 namespace colour {
 const cv::Scalar kBlack{0, 0, 0}, kGrey{150, 150, 150}, kLightGrey{225, 225, 225}, kWhite{255, 255, 255};
 const cv::Scalar kRed{40, 40, 200};
-/// Series colours (BGR), distinguishable in colour-blind palettes: blue, orange, green, purple.
-const std::vector<cv::Scalar> kSeries{{178, 114, 0}, {0, 140, 230}, {115, 158, 0}, {167, 121, 204}};
+/// Series colours (BGR), distinguishable in colour-blind palettes (Okabe-Ito): blue, orange, green, purple,
+/// vermillion, near-black.
+const std::vector<cv::Scalar> kSeries{{178, 114, 0},   {0, 140, 230}, {115, 158, 0},
+                                      {167, 121, 204}, {0, 94, 213},  {40, 40, 40}};
 }  // namespace colour
 
 enum class Align { Left, Centre, Right };

@@ -144,12 +144,13 @@ def relative(gt_t, gt_s):
     return [[sum(gt_t[i][k] * inv[k][j] for k in range(4)) for j in range(4)] for i in range(3)]
 
 
-def proc_figures(pid):
-    """RSS, peak RSS, threads and open fds of a running tomomapd (None while `ip netns exec` has not exec'd it)."""
+def proc_figures(pid, name):
+    """RSS, peak RSS, threads and open fds of the running daemon `name` (None while the process that
+    starts it, python's fork and then `ip netns exec`, has not exec'd it yet)."""
     fig = {}
     try:
         with open(f"/proc/{pid}/comm") as f:
-            if f.read().strip() == "ip":
+            if f.read().strip() != os.path.basename(name)[:15]:  # the kernel keeps 15 characters
                 return None
         with open(f"/proc/{pid}/status") as f:
             for line in f:
@@ -366,7 +367,7 @@ def main():
                             log(t, f"WRONG: {agents[x]} holds {key[1]} {err:.2f} m from the ground truth")
             if t >= next_sample:
                 for i in range(n):
-                    fig = proc_figures(procs[i].pid)
+                    fig = proc_figures(procs[i].pid, args.tomomapd)
                     if fig:
                         samples.append({"minute": round(t / 60, 2), "agent": agents[i], "pid": procs[i].pid,
                                         "rss_mb": round(fig["VmRSS"], 1), "hwm_mb": round(fig["VmHWM"], 1),
