@@ -43,9 +43,7 @@ const toml::table* knownTable(const Reader& r, const toml::table& root, const st
   if (!t) r.fail(*node, name, "must be a table ([" + name + "])");
   for (const auto& [key, value] : *t) {
     const std::string full = name + "." + std::string(key.str());
-    const auto& all = settings();
-    if (std::none_of(all.begin(), all.end(), [&](const Setting& s) { return s.key == full; }))
-      r.fail(value, full, "unknown key (see docs/configuration.md)");
+    if (!isSetting(full)) r.fail(value, full, "unknown key (see docs/configuration.md)");
   }
   return t;
 }
@@ -108,8 +106,8 @@ void readPeers(const Reader& r, const toml::table& root, transport::TransportCon
     const toml::table* p = e.as_table();
     if (!p) r.fail(e, "peer", "each [[peer]] must be a table");
     for (const auto& [key, node] : *p) {
-      const std::string k(key.str());
-      if (k != "id" && k != "host" && k != "port") r.fail(node, "peer." + k, "unknown key (use id, host, port)");
+      const std::string full = "peer." + std::string(key.str());
+      if (!isSetting(full)) r.fail(node, full, "unknown key (use id, host, port)");
     }
     const auto read = [&](const char* key) {
       const Setting& s = setting(std::string("peer.") + key);

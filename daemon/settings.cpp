@@ -1,5 +1,6 @@
 #include "settings.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <deque>
 #include <filesystem>
@@ -15,7 +16,6 @@ using K = SettingKind;
 using V = SettingValue;
 using Check = std::optional<std::string>;
 
-double number(const V& v) { return std::get<double>(v); }
 const std::string& text(const V& v) { return std::get<std::string>(v); }
 
 Check agentId(const V& v) {
@@ -81,28 +81,6 @@ class Declare {
   std::deque<Setting> all;  ///< a deque: each reference returned stays valid as more are declared
 };
 
-V toValue(bool b) { return b; }
-V toValue(const std::string& t) { return t; }
-template <typename Number>
-V toValue(Number n) {
-  return static_cast<double>(n);
-}
-void fromValue(const V& v, bool& b) { b = std::get<bool>(v); }
-void fromValue(const V& v, std::string& t) { t = text(v); }
-template <typename Number>
-void fromValue(const V& v, Number& n) {
-  n = static_cast<Number>(number(v));
-}
-
-/// Reads and writes the field `at` points to (a lambda Config& -> T*): one
-/// accessor serves both, so the field is named once.
-template <typename At>
-Setting& field(Setting& s, At at) {
-  s.get = [at](const Config& c) { return toValue(*at(const_cast<Config&>(c))); };  // read only
-  s.set = [at](Config& c, const V& v) { fromValue(v, *at(c)); };
-  return s;
-}
-
 std::vector<Setting> declare() {
   Declare d;
   auto range = [](Setting& s, double lo, double hi) -> Setting& {
@@ -114,7 +92,7 @@ std::vector<Setting> declare() {
         d("agent", K::Text, "", Reload::Restart, "this agent's id: 1-32 of `A-Z a-z 0-9 - _`; unique in the fleet");
     s.required = true;
     s.check = agentId;
-    field(s, [](Config& c) { return &c.transport.agent; });
+    bindField(s, [](Config& c) { return &c.transport.agent; });
   }
   {
     Setting& s = d("map", K::Text, "path", Reload::AtOnce,
@@ -124,42 +102,42 @@ std::vector<Setting> declare() {
                    "an error (exit 2)");
     s.path = true;
     s.default_text = "required (unless `[ros2]` `map_topic`)";
-    field(s, [](Config& c) { return &c.map; });
+    bindField(s, [](Config& c) { return &c.map; });
   }
   d.match(matchSetting("grid"), "grid");
-  field(range(d("domain", K::Integer, "", Reload::Rejoin, "DDS domain id, the same on every agent"), 0, 232),
-        [](Config& c) { return &c.transport.domain; });
+  bindField(range(d("domain", K::Integer, "", Reload::Rejoin, "DDS domain id, the same on every agent"), 0, 232),
+            [](Config& c) { return &c.transport.domain; });
   {
     Setting& s = d("address", K::Text, "IPv4", Reload::Rejoin, "this agent's address, where peers reach it");
     s.check = ipv4;
-    field(s, [](Config& c) { return &c.transport.address; });
+    bindField(s, [](Config& c) { return &c.transport.address; });
   }
   {
     Setting& s =
         range(d("discovery_port", K::Integer, "UDP port", Reload::Rejoin, "discovery traffic (peers list this port)"),
               1024, 65534);
     s.required = true;
-    field(s, [](Config& c) { return &c.transport.discovery_port; });
+    bindField(s, [](Config& c) { return &c.transport.discovery_port; });
   }
   {
     Setting& s =
         range(d("data_port", K::Integer, "UDP port", Reload::Rejoin, "user data; not discovery_port"), 1024, 65535);
     s.default_text = "discovery_port + 1";
-    field(s, [](Config& c) { return &c.transport.data_port; });
+    bindField(s, [](Config& c) { return &c.transport.data_port; });
   }
-  field(range(d("bandwidth_kbps", K::Number, "kbit/s", Reload::Rejoin,
-                "budget for everything the daemon sends (slices, discovery, acknowledgements, requests, "
-                "estimates), counted with IP, UDP and Ethernet headers and held over any 5 s window "
-                "(docs/protocol.md)"),
-              64, 10'000'000),
-        [](Config& c) { return &c.transport.bandwidth_kbps; });
+  bindField(range(d("bandwidth_kbps", K::Number, "kbit/s", Reload::Rejoin,
+                    "budget for everything the daemon sends (slices, discovery, acknowledgements, requests, "
+                    "estimates), counted with IP, UDP and Ethernet headers and held over any 5 s window "
+                    "(docs/protocol.md)"),
+                  64, 10'000'000),
+            [](Config& c) { return &c.transport.bandwidth_kbps; });
   {
     Setting& s = d("output_dir", K::Text, "path", Reload::AtOnce,
                    "`transforms.json`, `frame.json`, `status.json` (read by `tomomap status`); under the systemd "
                    "unit the default is its `StateDirectory`");
     s.path = true;
     s.default_text = "`$STATE_DIRECTORY`, else \"/var/lib/tomomap\"";
-    field(s, [](Config& c) { return &c.output_dir; });
+    bindField(s, [](Config& c) { return &c.output_dir; });
   }
   {
     Setting& s = d("log_level", K::Text, "", Reload::AtOnce, "`debug`, `info`, `warning` or `error`");
@@ -174,30 +152,30 @@ std::vector<Setting> declare() {
         if (text(v) == kLevels[i]) c.log_level = static_cast<LogLevel>(i);
     };
   }
-  field(range(d("claim_timeout_s", K::Number, "s", Reload::AtOnce,
-                "a claim without a result after this long is void and the next agent in the pair's order "
-                "computes it; also how long each agent waits before taking a pair from the one ahead of it "
-                "in that order (docs/protocol.md, \"Claim, compute, broadcast\")"),
-              1, 3600),
-        [](Config& c) { return &c.claim_timeout_s; });
-  field(range(d("request_interval_s", K::Number, "s", Reload::AtOnce,
-                "ask a peer again for missing slices after this long without progress"),
-              0.1, 600),
-        [](Config& c) { return &c.request_interval_s; });
-  field(range(d("peer_memory_mb", K::Number, "MB", Reload::AtOnce,
-                "memory one peer's map may take on this agent: an announcement whose payload plus one raster "
-                "image exceeds it is refused before anything is allocated, and a map whose inflated "
-                "occupancy would exceed it is refused as it arrives (one log line, counted as "
-                "`rejected_samples`)"),
-              1, 65536),
-        [](Config& c) { return &c.peer_memory_mb; });
+  bindField(range(d("claim_timeout_s", K::Number, "s", Reload::AtOnce,
+                    "a claim without a result after this long is void and the next agent in the pair's order "
+                    "computes it; also how long each agent waits before taking a pair from the one ahead of it "
+                    "in that order (docs/protocol.md, \"Claim, compute, broadcast\")"),
+                  1, 3600),
+            [](Config& c) { return &c.claim_timeout_s; });
+  bindField(range(d("request_interval_s", K::Number, "s", Reload::AtOnce,
+                    "ask a peer again for missing slices after this long without progress"),
+                  0.1, 600),
+            [](Config& c) { return &c.request_interval_s; });
+  bindField(range(d("peer_memory_mb", K::Number, "MB", Reload::AtOnce,
+                    "memory one peer's map may take on this agent: an announcement whose payload plus one raster "
+                    "image exceeds it is refused before anything is allocated, and a map whose inflated "
+                    "occupancy would exceed it is refused as it arrives (one log line, counted as "
+                    "`rejected_samples`)"),
+                  1, 65536),
+            [](Config& c) { return &c.peer_memory_mb; });
   {
     Setting& s = d("reference", K::Text, "agent id", Reload::AtOnce,
                    "whose map is the fleet's frame: `frame.json` gives every agent's pose in it (this agent or a "
                    "peer; every agent of a fleet should name the same one)");
     s.default_text = "the lowest agent id of the fleet";
     s.shown = [](const Config& c) { return c.frameReference(); };
-    field(s, [](Config& c) { return &c.reference; });
+    bindField(s, [](Config& c) { return &c.reference; });
   }
   for (const MatchSetting& m : matchSettings())
     if (m.key != "grid") d.match(m, "match." + m.key);
@@ -220,34 +198,34 @@ std::vector<Setting> declare() {
     s.default_text = "required with `[security]`";
     return s;
   };
-  field(security("ca",
-                 "the fleet CA's certificate (PEM): it must have issued every peer's certificate and signed "
-                 "the governance and permissions documents. With the `[security]` table every agent of the "
-                 "fleet needs one"),
-        [](Config& c) { return &c.transport.security.ca; })
+  bindField(security("ca",
+                     "the fleet CA's certificate (PEM): it must have issued every peer's certificate and signed "
+                     "the governance and permissions documents. With the `[security]` table every agent of the "
+                     "fleet needs one"),
+            [](Config& c) { return &c.transport.security.ca; })
       .default_text = "none: security off";
-  field(security("certificate", "this agent's certificate (PEM); its common name must be `agent` (peers check it)"),
-        [](Config& c) { return &c.transport.security.certificate; });
-  field(security("private_key", "its private key (PEM, readable by the service only)"),
-        [](Config& c) { return &c.transport.security.private_key; });
-  field(security("governance", "the signed domain rules (S/MIME), the same on every agent"),
-        [](Config& c) { return &c.transport.security.governance; });
-  field(security("permissions", "this agent's signed grant (S/MIME)"),
-        [](Config& c) { return &c.transport.security.permissions; });
-  field(security("crl", "optional: the fleet's revocation list (PEM); certificates on it cannot join"), [](Config& c) {
-    return &c.transport.security.crl;
-  }).default_text = "none";
+  bindField(security("certificate", "this agent's certificate (PEM); its common name must be `agent` (peers check it)"),
+            [](Config& c) { return &c.transport.security.certificate; });
+  bindField(security("private_key", "its private key (PEM, readable by the service only)"),
+            [](Config& c) { return &c.transport.security.private_key; });
+  bindField(security("governance", "the signed domain rules (S/MIME), the same on every agent"),
+            [](Config& c) { return &c.transport.security.governance; });
+  bindField(security("permissions", "this agent's signed grant (S/MIME)"),
+            [](Config& c) { return &c.transport.security.permissions; });
+  bindField(security("crl", "optional: the fleet's revocation list (PEM); certificates on it cannot join"),
+            [](Config& c) { return &c.transport.security.crl; })
+      .default_text = "none";
   {
     Setting& s = d("ros2.enabled", K::Flag, "", Reload::RestartsRos2,
                    "publish the fleet's frames on ROS 2's `/tf_static` and this daemon's health on `/diagnostics` "
                    "(docs/operations.md, \"ROS 2\"); without the table, off");
     s.default_text = "true with `[ros2]`";
-    field(s, [](Config& c) { return &c.ros2.enabled; });
+    bindField(s, [](Config& c) { return &c.ros2.enabled; });
   }
-  field(range(d("ros2.domain", K::Integer, "", Reload::RestartsRos2,
-                "the ROS 2 nodes' `ROS_DOMAIN_ID` (independent of `domain` above)"),
-              0, 232),
-        [](Config& c) { return &c.ros2.domain; });
+  bindField(range(d("ros2.domain", K::Integer, "", Reload::RestartsRos2,
+                    "the ROS 2 nodes' `ROS_DOMAIN_ID` (independent of `domain` above)"),
+                  0, 232),
+            [](Config& c) { return &c.ros2.domain; });
   {
     Setting& s =
         d("ros2.frame", K::Text, "", Reload::RestartsRos2, "frame id of each robot's map; `{agent}` becomes its id");
@@ -255,7 +233,7 @@ std::vector<Setting> declare() {
       if (text(v).find("{agent}") != std::string::npos) return std::nullopt;
       return "must contain {agent} (each map needs its own frame)";
     };
-    field(s, [](Config& c) { return &c.ros2.frame; });
+    bindField(s, [](Config& c) { return &c.ros2.frame; });
   }
   {
     Setting& s = d("ros2.root", K::Text, "agent id", Reload::RestartsRos2,
@@ -263,14 +241,14 @@ std::vector<Setting> declare() {
                    "agent or a peer)");
     s.default_text = "`reference`";
     s.shown = [](const Config& c) { return c.treeRoot(); };
-    field(s, [](Config& c) { return &c.ros2.root; });
+    bindField(s, [](Config& c) { return &c.ros2.root; });
   }
-  field(d("ros2.localhost_only", K::Flag, "", Reload::RestartsRos2,
-          "reach ROS 2 nodes on this robot only, under any ROS 2 discovery setting that keeps them on it "
-          "(`ROS_LOCALHOST_ONLY=1`, Jazzy's `LOCALHOST`, static peers on this host), and send nothing to "
-          "the network; false: multicast discovery on every interface too, for ROS 2's defaults, whose "
-          "traffic also crosses the robots' link (docs/operations.md, \"ROS 2\")"),
-        [](Config& c) { return &c.ros2.localhost_only; });
+  bindField(d("ros2.localhost_only", K::Flag, "", Reload::RestartsRos2,
+              "reach ROS 2 nodes on this robot only, under any ROS 2 discovery setting that keeps them on it "
+              "(`ROS_LOCALHOST_ONLY=1`, Jazzy's `LOCALHOST`, static peers on this host), and send nothing to "
+              "the network; false: multicast discovery on every interface too, for ROS 2's defaults, whose "
+              "traffic also crosses the robots' link (docs/operations.md, \"ROS 2\")"),
+            [](Config& c) { return &c.ros2.localhost_only; });
   {
     Setting& s = d("ros2.map_topic", K::Text, "ROS 2 topic name", Reload::RestartsRos2,
                    "read the robot's map from this `sensor_msgs/PointCloud2` topic (its SLAM's map cloud, e.g. "
@@ -282,7 +260,7 @@ std::vector<Setting> declare() {
     s.check = rosTopic;
     s.default_text = "none";
     s.shown = [](const Config& c) { return c.ros2.map_topic.empty() ? "(none: the map file)" : c.ros2.map_topic; };
-    field(s, [](Config& c) { return &c.ros2.map_topic; });
+    bindField(s, [](Config& c) { return &c.ros2.map_topic; });
   }
   return {d.all.begin(), d.all.end()};
 }
@@ -305,6 +283,11 @@ const std::vector<Setting>& settings() {
 }
 
 const Setting& setting(const std::string& key) { return findSetting(settings(), key); }
+
+bool isSetting(const std::string& key) {
+  const auto& all = settings();
+  return std::any_of(all.begin(), all.end(), [&](const Setting& s) { return s.key == key; });
+}
 
 std::vector<std::string> changed(const Config& a, const Config& b, Reload reload) {
   std::vector<std::string> keys;

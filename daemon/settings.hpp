@@ -42,6 +42,8 @@ struct Setting : SettingOf<Config> {
 const std::vector<Setting>& settings();
 /// The one named `key` ("discovery_port", "match.threads"); std::logic_error if there is none.
 const Setting& setting(const std::string& key);
+/// Whether `key` is declared (an unknown key in a config file is an error).
+bool isSetting(const std::string& key);
 
 /// The keys whose values differ between two configs and that need `reload` to take effect.
 std::vector<std::string> changed(const Config& a, const Config& b, Reload reload);
