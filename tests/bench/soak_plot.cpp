@@ -3,6 +3,7 @@
 // per daemon, so growth shows as a slope and a restart as a drop.
 //   soak_plot SAMPLES.csv OUT.png
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -32,12 +33,19 @@ int main(int argc, char** argv) {
     if (!std::getline(row, minute, ',') || !std::getline(row, agent, ',') || !std::getline(row, pid, ',') ||
         !std::getline(row, rss_mb, ',') || !std::getline(row, hwm_mb, ',') || !std::getline(row, fd_count, ','))
       continue;
+    double at = 0, resident = 0, open = 0;
+    try {
+      at = std::stod(minute), resident = std::stod(rss_mb), open = std::stod(fd_count);
+    } catch (const std::exception&) {
+      std::fprintf(stderr, "soak_plot: skipped a row that is not numbers: %s\n", line.c_str());
+      continue;
+    }
     for (auto* s : {&rss[agent], &fds[agent]}) {
       s->name = agent;
-      s->x.push_back(std::stod(minute));
+      s->x.push_back(at);
     }
-    rss[agent].y.push_back(std::stod(rss_mb));
-    fds[agent].y.push_back(std::stod(fd_count));
+    rss[agent].y.push_back(resident);
+    fds[agent].y.push_back(open);
   }
   viz::LinePanel memory{"resident memory of each daemon", "minutes", "RSS [MB]", {}};
   viz::LinePanel files{"open file descriptors of each daemon", "minutes", "file descriptors", {}};
