@@ -74,14 +74,17 @@ void FleetOutputs::handTree(const Config& config) {
 void FleetOutputs::write(const Config& config) {
   const std::filesystem::path dir(config.output_dir);
   try {
-    nlohmann::json list = nlohmann::json::array();
-    for (const auto& t : agreed_) list.push_back(toJson(t));
-    writeJsonAtomically((dir / "transforms.json").string(),
-                        {{"schema_version", kJsonSchemaVersion}, {"agent", config.agent()}, {"transforms", list}});
+    // The frame first: whoever sees a transform in transforms.json then finds
+    // the frame built from it (a test that read frame.json as soon as
+    // transforms.json held the pair once found the frame of before).
     nlohmann::json frame = toJson(frame_);
     frame["schema_version"] = kJsonSchemaVersion;
     frame["agent"] = config.agent();
     writeJsonAtomically((dir / "frame.json").string(), frame);
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& t : agreed_) list.push_back(toJson(t));
+    writeJsonAtomically((dir / "transforms.json").string(),
+                        {{"schema_version", kJsonSchemaVersion}, {"agent", config.agent()}, {"transforms", list}});
     if (unwritten_) log_.info("transforms.json written again: it holds every agreed transform");
     unwritten_ = false;
     write_error_.clear();
