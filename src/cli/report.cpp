@@ -71,6 +71,9 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
                     r.method == "dense" ? "found this answer" : "ran beside the features", r.dense_cell, r.dense_lead);
     if (r.dense_pooled_lead > 0)
       out << format("                 on occupancy pooled to twice the cell: %.2fx\n", r.dense_pooled_lead);
+    if (r.dense_wide_lead > 0)
+      out << format("                 on a raster twice as fine, checking the features' answer: %.2fx\n",
+                    r.dense_wide_lead);
     out << "tilt             target " << tiltText(r.target_tilt) << ", source " << tiltText(r.source_tilt) << "\n";
     out << format(
         "slices           target %d (%zu features), source %d (%zu features), %zu of %zu slice pairs matched\n",
@@ -105,6 +108,7 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
                   {"dense_lead", r.dense_lead},
                   {"dense_cell", r.dense_cell},
                   {"dense_pooled_lead", r.dense_pooled_lead},
+                  {"dense_wide_lead", r.dense_wide_lead},
                   {"support", r.support},
                   {"height_offset_slices", r.height_offset},
                   {"runner_up_support", r.runner_up_support},

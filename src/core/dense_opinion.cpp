@@ -26,9 +26,10 @@ struct Opinion {
 /// `pooling`), and brings the best pose back to the maps' own grid: its
 /// offset in their slices, its transform refined on their cells.
 Opinion searchAt(const MapFeatures& target, const MapFeatures& source, const SliceStack& t, const SliceStack& s,
-                 int pooling, const MatchParams& params) {
+                 int pooling, const MatchParams& params, int coarse_side = DenseSearchParams{}.coarse_side) {
   DenseSearchParams dp;
   dp.threads = matchThreads(params);
+  dp.coarse_side = coarse_side;
   const ConsensusParams same = consensusParams(params, t.grid.cell);
   Opinion o{searchDensely(t, s, same, source.centre(), dp), t.grid.cell, pooling, same};
   for (DensePose& p : o.search.poses) p.offset *= pooling;
@@ -105,7 +106,7 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
                  const MatchParams& params) {
   const auto t0 = std::chrono::steady_clock::now();
   const bool features = r.support > 0;  // the features proposed an answer (judged or not)
-  std::optional<Opinion> at_grid, at_pooled;
+  std::optional<Opinion> at_grid, wide, at_pooled;
   Verdict v;
   while ((v = decideMatch(e, params)).needs != Verdict::Needs::nothing) {
     switch (v.needs) {
@@ -113,6 +114,11 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
         at_grid = searchAt(target, source, target.occupancy, source.occupancy, 1, params);
         e.at_grid = evidenceOf(*at_grid, r, features, target, source);
         if (at_grid->found()) r.dense_lead = e.at_grid->lead(), r.dense_cell = at_grid->cell;
+        break;
+      case Verdict::Needs::wide_search:
+        wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, kWideCoarseSide);
+        e.wide = evidenceOf(*wide, r, features, target, source);
+        if (wide->found()) r.dense_wide_lead = e.wide->lead();
         break;
       case Verdict::Needs::features_landed:
         e.features_landed = landPose(target.occupancy, source.occupancy, planar(r.T_target_source), r.height_offset);
@@ -133,6 +139,7 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
   r.reliable = v.by != Verdict::By::none;
   r.reason = v.reason;
   if (v.by == Verdict::By::at_grid) answer(r, *at_grid, *e.at_grid, target, source);
+  if (v.by == Verdict::By::wide) answer(r, *wide, *e.wide, target, source);
   if (v.by == Verdict::By::pooled) answer(r, *at_pooled, *e.pooled, target, source);
   if (r.reliable) takeOccupancyHeight(r, target, source);
   r.timings.dense = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -126,14 +126,17 @@ std::vector<int> landings(const std::vector<Cell>& cells, const Rigid2D& T, cons
 /// target cell at height `offset`.
 struct Tally {
   size_t inliers = 0, telling = 0;
-  int slices = 0;           ///< source slices with at least half their cells on the target
+  int slices = 0;  ///< source slices with at least half their cells on the target
+  /// The same, of the cells that land where the target saw anything at any height (`seen`).
+  int slices_seen = 0;
   size_t contradicted = 0;  ///< telling cells off the target, in space it encloses (if given)
 };
 
 Tally countInliers(const std::vector<cv::Mat>& dilated, const std::vector<Cell>& cells, const std::vector<int>& landing,
-                   int offset, int source_slices, const Enclosure* enclosure = nullptr) {
+                   int offset, int source_slices, const Enclosure* enclosure = nullptr,
+                   const cv::Mat* seen = nullptr) {
   Tally t;
-  std::vector<size_t> on(static_cast<size_t>(source_slices), 0), all(static_cast<size_t>(source_slices), 0);
+  std::vector<size_t> on(static_cast<size_t>(source_slices), 0), all(on), all_seen(on);
   for (size_t n = 0; n < cells.size(); ++n) {
     const Cell& c = cells[n];
     const int i = c.slice + offset;
@@ -141,6 +144,7 @@ Tally countInliers(const std::vector<cv::Mat>& dilated, const std::vector<Cell>&
     ++all[static_cast<size_t>(c.slice)];
     // Dilated images are continuous: pixel index = element index.
     if (landing[n] < 0) continue;
+    if (seen && seen->ptr<uint8_t>()[landing[n]]) ++all_seen[static_cast<size_t>(c.slice)];
     if (!dilated[static_cast<size_t>(i)].ptr<uint8_t>()[landing[n]]) {
       t.contradicted += c.telling && enclosure && enclosure->encloses(landing[n], i);
       continue;
@@ -149,7 +153,10 @@ Tally countInliers(const std::vector<cv::Mat>& dilated, const std::vector<Cell>&
     t.telling += c.telling;
     ++on[static_cast<size_t>(c.slice)];
   }
-  for (size_t k = 0; k < on.size(); ++k) t.slices += all[k] > 0 && 2 * on[k] >= all[k];
+  for (size_t k = 0; k < on.size(); ++k) {
+    t.slices += all[k] > 0 && 2 * on[k] >= all[k];
+    t.slices_seen += all_seen[k] > 0 && 2 * on[k] >= all_seen[k];
+  }
   return t;
 }
 
@@ -164,6 +171,15 @@ std::vector<cv::Mat> dilatedSlices(const SliceStack& stack, const DenseSearchPar
   return images;
 }
 
+/// Where a map saw anything at any height: the union of its dilated slices
+/// (continuous, of the raster's size).
+cv::Mat footprint(const SliceStack& stack, const std::vector<cv::Mat>& dilated) {
+  cv::Mat out = cv::Mat::zeros(stack.grid.height, stack.grid.width, CV_8U);
+  for (const cv::Mat& m : dilated)
+    if (!m.empty()) cv::bitwise_or(out, m, out);
+  return out;
+}
+
 /// What a pose is judged on, built once per pair of maps: both maps' dilated
 /// occupancy, their cells and the space each saw empty.
 struct PoseJudge {
@@ -171,6 +187,7 @@ struct PoseJudge {
   std::vector<cv::Mat> dilated, source_dilated;
   std::vector<Cell> source_cells, target_cells;
   Enclosure target_encloses, source_encloses;
+  cv::Mat target_seen;
   const Enclosure *in_target, *in_source;  ///< null on cells too fine to read empty space
 
   PoseJudge(const SliceStack& t, const SliceStack& s, const DenseSearchParams& params)
@@ -182,17 +199,19 @@ struct PoseJudge {
         target_cells(cellsOf(t, params.wall_spread)),
         target_encloses(t),
         source_encloses(s),
+        target_seen(footprint(t, dilated)),
         in_target(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &target_encloses : nullptr),
         in_source(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &source_encloses : nullptr) {}
 
   /// The source's cells, landed on the target's raster at `landing`, at height `offset`.
   Tally forth(const std::vector<int>& landing, int offset) const {
-    return countInliers(dilated, source_cells, landing, offset, source.size(), in_target);
+    return countInliers(dilated, source_cells, landing, offset, source.size(), in_target, &target_seen);
   }
   /// Sets p's tally from the source's cells landed on the target (at `landing`)
   /// and adds the target's landed back on the source: both ways.
   void judge(DensePose& p, const Tally& there) const {
     p.inliers = there.inliers, p.telling_inliers = there.telling, p.support = there.slices;
+    p.support_seen = there.slices_seen;
     p.contradicted = there.contradicted;
     const std::vector<int> back = landings(target_cells, p.transform.inverse(), source.grid);
     const Tally here = countInliers(source_dilated, target_cells, back, -p.offset, target.size(), in_source);

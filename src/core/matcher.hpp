@@ -55,6 +55,9 @@ struct MatchResult {
   /// The dense search's lead on occupancy pooled to twice the cell, where the
   /// map's grid left the pair refused; 0 when it did not run.
   double dense_pooled_lead = 0;
+  /// The lead of the search on a raster twice as fine, asked where the
+  /// features found an answer on too few slice pairs (verdict.hpp); 0 when it did not run.
+  double dense_wide_lead = 0;
   int support = 0;            ///< agreeing slice pairs at the winning height offset
   int runner_up_support = 0;  ///< best support of another answer (OffsetChoice)
   int runner_up_offset = 0;   ///< its height offset [slices]

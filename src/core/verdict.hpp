@@ -68,22 +68,27 @@ struct Evidence {
   FeatureEvidence features;
   double grid = 0;                           ///< the maps' grid [m]
   std::optional<DenseEvidence> at_grid;      ///< the dense search on the maps' own occupancy
+  std::optional<DenseEvidence> wide;         ///< the same on a raster twice as fine (kWideCoarseSide)
   std::optional<DensePose> features_landed;  ///< the features' answer landed on the maps' own occupancy
   std::optional<DenseEvidence> pooled;       ///< the dense search on occupancy pooled to twice the cell
   bool pooled_at_grid_best = false;          ///< the pooled search's best pose is the grid search's
 };
 
 struct Verdict {
-  enum class By { none, features, at_grid, pooled };
+  enum class By { none, features, at_grid, wide, pooled };
   By by = By::none;    ///< which search's answer is the answer; none: no reliable match
   std::string reason;  ///< why there is none
   /// Evidence the verdict needs before it can decide: gather it and ask again.
-  enum class Needs { nothing, search_at_grid, features_landed, pooled_search };
+  enum class Needs { nothing, search_at_grid, wide_search, features_landed, pooled_search };
   Needs needs = Needs::nothing;
 };
 
 /// The verdict on `e`. A feature answer that leads its runner-up clearly
-/// (weakWinner) stands alone. Otherwise the dense search at the map's grid
+/// (weakWinner) stands alone. One on fewer than min_support slice pairs
+/// stands where the wide search's best pose lands on it and confirms it
+/// (kDenseOpinion, beyond chance, over min_support of the slices that land
+/// where the other map saw anything): the one of the two poses that lands
+/// more telling cells is the answer. Otherwise the dense search at the map's grid
 /// confirms it (its best pose is the features' and leads by kDenseOpinion),
 /// replaces it (its best pose elsewhere leads by kDenseLead), or refuses it;
 /// a search whose best pose contradicts what the other map saw empty found no

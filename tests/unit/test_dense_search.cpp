@@ -116,3 +116,31 @@ TEST(DenseSearch, LandingAGivenPoseTalliesItAsTheSearchDoes) {
   const DensePose turned = landPose(room, room, half, 0);
   EXPECT_GT(turned.contradicted, itself.contradicted + 100) << turned.telling_inliers << " telling";
 }
+
+// Two crops of one room sharing a fifth of it, at the right pose: a slice
+// cannot land half of all its cells on the other crop (most lie where the
+// other never looked), but it lands half of those that fall where the other
+// saw anything. support_seen is what confirms a thin feature answer on a
+// partial overlap (verdict.hpp).
+TEST(DenseSearch, ASliceOfAPartialCropHoldsOnTheCellsThatLandWhereTheOtherMapSawAnything) {
+  const Points room = roomScan();
+  std::vector<float> xs;
+  for (const auto& p : room) xs.push_back(p.x());
+  std::sort(xs.begin(), xs.end());
+  const float target_end = xs[xs.size() * 2 / 5], source_begin = xs[xs.size() / 5];
+  Points near, far;
+  for (const auto& p : room) {
+    if (p.x() <= target_end) near.push_back(p);
+    if (p.x() >= source_begin) far.push_back(p);
+  }
+  const SliceStack t = stackOf(near), s = stackOf(far);
+  const int offset = static_cast<int>(std::lround((s.grid.z_min - t.grid.z_min) / kGrid));
+  const DensePose right = landPose(t, s, Rigid2D{}, offset);
+  std::cout << s.size() << " source slices; the right pose holds over " << right.support << " counting every cell, "
+            << right.support_seen << " counting those landing where the target saw anything\n";
+  EXPECT_LT(right.support, s.size() / 4) << "of all its cells";
+  EXPECT_GT(right.support_seen, s.size() / 2) << "of those landing where the other crop saw anything";
+  const DensePose apart = landPose(t, s, Rigid2D{0.0, Eigen::Vector2d(0.0, 1.5)}, offset);
+  std::cout << "a pose 1.5 m off: " << apart.support_seen << "\n";
+  EXPECT_LT(apart.support_seen, right.support_seen / 2) << "a pose 1.5 m off";
+}

@@ -28,6 +28,7 @@ DensePose landed(size_t telling, size_t contradicted = 0, int slices = 10) {
   p.contradicted = contradicted;
   p.inliers = telling;
   p.support = slices;
+  p.support_seen = slices;
   return p;
 }
 
@@ -51,11 +52,21 @@ struct Row {
   const char* reason;  ///< the reason begins so (by none, needs nothing)
 };
 
+/// The evidence of a row; a thin feature answer's wide search (asked first)
+/// found nothing unless the row says otherwise.
 Evidence with(FeatureEvidence f, std::optional<DenseEvidence> grid = std::nullopt, double cell = 0.1) {
   Evidence e;
   e.features = std::move(f);
   e.grid = cell;
   e.at_grid = std::move(grid);
+  e.wide = DenseEvidence{};
+  return e;
+}
+
+/// A thin feature answer (1 slice pair) and its wide search.
+Evidence thinWith(const DenseEvidence& wide) {
+  Evidence e = with(featureAnswer(1));
+  e.wide = wide;
   return e;
 }
 
@@ -76,8 +87,31 @@ TEST(Verdict, TruthTable) {
   tilted.tilted = "source map is tilted 5.0 +- 0.1 deg";
   add("a tilted map is refused before anything else", tilted, By::none, Needs::nothing, "source map is tilted");
   add("a strong feature winner stands alone", with(featureAnswer(30, 2)), By::features);
-  add("too few agreeing slice pairs: the dense search is asked", with(featureAnswer(2)), By::none,
+  Evidence thin = with(featureAnswer(2));
+  thin.wide.reset();
+  add("too few agreeing slice pairs: the wide search is asked first", thin, By::none, Needs::wide_search);
+  add("... then, where it did not confirm them, the dense search", with(featureAnswer(2)), By::none,
       Needs::search_at_grid);
+  Evidence confirmed = thinWith(search(landed(1300), 1000, true, 0.2));
+  add("... a wide search whose best pose is the features' and leads 1.3x: the features' landing is asked",
+      confirmed, By::none, Needs::features_landed);
+  confirmed.features_landed = landed(1400);
+  add("... and the features' answer stands where it lands more telling cells", confirmed, By::features);
+  confirmed.features_landed = landed(1200);
+  add("... the wide search's pose where that lands more", confirmed, By::wide);
+  DensePose partial = landed(1300);
+  partial.support = 1;  // a 30 % crop: 1 slice lands half of all its cells, 6 half of those the other map saw
+  partial.support_seen = 6;
+  Evidence crop = thinWith(search(partial, 1000, true, 0.2));
+  crop.features_landed = landed(1400);
+  add("... its slices judged on the cells that land where the other map saw anything", crop, By::features);
+  Evidence elsewhere = thinWith(search(landed(1300), 1000, false, 0.2));
+  add("a wide search whose best pose is elsewhere confirms nothing: the dense search is asked", elsewhere, By::none,
+      Needs::search_at_grid);
+  Evidence chance = thinWith(search(landed(130), 100, true, 0.2));
+  add("a wide lead of 130 to 100 is chance (1.9 sigma): not confirmed", chance, By::none, Needs::search_at_grid);
+  Evidence few = thinWith(search(landed(1300, 0, 2), 1000, true, 0.2));
+  add("a wide best pose over 2 slices does not confirm", few, By::none, Needs::search_at_grid);
   add("a weak winner: the dense search is asked", with(featureAnswer(10, 2)), By::none, Needs::search_at_grid);
   add("two answers within min_support pairs are ambiguous", with(featureAnswer(6, 4), DenseEvidence{}, 0.2), By::none,
       Needs::nothing, "ambiguous: another answer 12");
