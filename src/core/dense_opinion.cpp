@@ -22,14 +22,20 @@ struct Opinion {
   double nextScore() const { return search.poses.size() > 1 ? search.poses[1].score() : 0.0; }
 };
 
-/// Searches `target` and `source` (the maps' occupancy, or both pooled by
-/// `pooling`), and brings the best pose back to the maps' own grid: its
-/// offset in their slices, its transform refined on their cells.
-Opinion searchAt(const MapFeatures& target, const MapFeatures& source, const SliceStack& t, const SliceStack& s,
-                 int pooling, const MatchParams& params, int coarse_side = DenseSearchParams{}.coarse_side) {
+/// The search on a raster twice as fine, for a thin feature answer (verdict.hpp).
+DenseSearchParams wideSearch() {
   DenseSearchParams dp;
+  dp.coarse_side = kWideCoarseSide;
+  dp.min_coarsening = kWideMinCoarsening;
+  return dp;
+}
+
+/// Searches `target` and `source` (the maps' occupancy, or both pooled by
+/// `pooling`) with `dp`, and brings the best pose back to the maps' own grid:
+/// its offset in their slices, its transform refined on their cells.
+Opinion searchAt(const MapFeatures& target, const MapFeatures& source, const SliceStack& t, const SliceStack& s,
+                 int pooling, const MatchParams& params, DenseSearchParams dp = {}) {
   dp.threads = matchThreads(params);
-  dp.coarse_side = coarse_side;
   const ConsensusParams same = consensusParams(params, t.grid.cell);
   Opinion o{searchDensely(t, s, same, source.centre(), dp), t.grid.cell, pooling, same};
   for (DensePose& p : o.search.poses) p.offset *= pooling;
@@ -116,7 +122,7 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
         if (at_grid->found()) r.dense_lead = e.at_grid->lead(), r.dense_cell = at_grid->cell;
         break;
       case Verdict::Needs::wide_search:
-        wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, kWideCoarseSide);
+        wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch());
         e.wide = evidenceOf(*wide, r, features, target, source);
         if (wide->found()) r.dense_wide_lead = e.wide->lead();
         break;

@@ -268,7 +268,8 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
 
   const SliceGrid& tg = target.grid;
   const SliceGrid& sg = source.grid;
-  const int c = std::max(coarsening(target, params.coarse_side), coarsening(source, params.coarse_side));
+  const int c = std::max({coarsening(target, params.coarse_side), coarsening(source, params.coarse_side),
+                          params.min_coarsening});
   const double C = c * tg.cell;  // coarse cell [m]
 
   // Target: coarse binary images, one per c slices.
