@@ -92,6 +92,8 @@ benchWorld outdoor 2 street street 0.5 0.2 0.1
 rematch=${BUILD_DIR:-build}/tests/bench_rematch
 [ -f "$demo/demo-pcd1.pcd" ] && "$rematch" "$demo/demo-pcd1.pcd" "$demo/demo-pcd2.pcd" 0.05 "$runs"
 "$rematch" "$b/map_0.pcd" "$b/map_1.pcd" 0.05 "$runs"
+# What bounds reading and voxel-filtering the building's map at g 0.2.
+"${BUILD_DIR:-build}/tests/bench_load" "$work/indoor-1/map_0.pcd" 0.2 "$runs"
 # Pair-matching time against slices (the building cropped by height), both
 # searches; redraws docs/img/scaling.png.
 echo "pair matching against slices, building at g 0.05:"
