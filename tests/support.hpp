@@ -1,8 +1,9 @@
 #pragma once
-// Helpers shared by the test programs: data paths, temporary directories, running the CLI.
+// Helpers shared by the test programs: data paths, temporary directories, running the CLI, timing.
 #include <gtest/gtest.h>
 
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,14 @@
 #include "io/map_io.hpp"
 
 namespace tomomap::test {
+
+/// How long f() takes [s] (the benchmarks').
+template <typename F>
+double secondsOf(F&& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 inline std::string demoRoom() { return TOMOMAP_DEMO_ROOM; }
 inline bool haveDemoRoom() { return std::filesystem::exists(demoRoom() + "/demo-pcd1.pcd"); }

@@ -4,7 +4,6 @@
 // Usage: bench_load MAP.pcd GRID [RUNS]
 #include <lzf.h>
 
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -15,19 +14,10 @@
 #include "core/stats.hpp"
 #include "core/voxel_filter.hpp"
 #include "io/map_io.hpp"
+#include "support.hpp"
 
 using namespace tomomap;
-
-namespace {
-
-template <typename F>
-double secondsOf(F&& f) {
-  const auto t0 = std::chrono::steady_clock::now();
-  f();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-}  // namespace
+using test::secondsOf;
 
 int main(int argc, char** argv) {
   if (argc < 3) {

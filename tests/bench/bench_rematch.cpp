@@ -3,7 +3,6 @@
 // slice pairs of the first match recalled (core/pair_cache.hpp).
 // Usage: bench_rematch TARGET.pcd SOURCE.pcd GRID [RUNS]
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -15,17 +14,7 @@
 #include "support.hpp"
 
 using namespace tomomap;
-
-namespace {
-
-template <typename F>
-double secondsOf(F&& f) {
-  const auto t0 = std::chrono::steady_clock::now();
-  f();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-}  // namespace
+using test::secondsOf;
 
 int main(int argc, char** argv) {
   if (argc < 4) {
