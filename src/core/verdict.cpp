@@ -57,10 +57,14 @@ std::string featureRefusal(const FeatureEvidence& f, const MatchParams& params) 
   return "";
 }
 
+/// Whether a search found a best pose that leads its next by `by`, beyond chance.
+bool aheadBeyondChance(const DenseEvidence& d, double by) {
+  return d.found && d.lead() >= by && significance(d.best.score(), d.next_score) >= kSignificant;
+}
+
 /// Whether a search's best pose leads by `by`, beyond chance, and holds.
 bool leads(const DenseEvidence& d, double by, const MatchParams& params) {
-  return d.found && d.lead() >= by && significance(d.best.score(), d.next_score) >= kSignificant &&
-         holdsOver(d.best, params.min_support);
+  return aheadBeyondChance(d, by) && holdsOver(d.best, params.min_support);
 }
 
 /// A feature answer on too few slice pairs to stand alone.
@@ -73,8 +77,7 @@ bool thinFeatureAnswer(const FeatureEvidence& f, const MatchParams& params) {
 /// slices that land where the other map saw anything (support_seen: crops
 /// share 20-60 %).
 bool confirmsThin(const DenseEvidence& d, const MatchParams& params) {
-  return d.found && d.at_features && d.lead() >= kDenseOpinion &&
-         significance(d.best.score(), d.next_score) >= kSignificant && consistent(d.best) &&
+  return d.at_features && aheadBeyondChance(d, kDenseOpinion) && consistent(d.best) &&
          d.best.support_seen >= params.min_support;
 }
 
