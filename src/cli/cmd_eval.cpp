@@ -110,7 +110,7 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   return row;
 }
 
-std::string summary(const std::string& suite, const std::vector<Row>& rows) {
+std::string summary(const std::string& suite, const std::vector<Row>& rows, const std::vector<std::string>& skipped) {
   std::map<std::pair<std::string, std::string>, std::vector<const Row*>> groups;
   for (const auto& r : rows) groups[{r.method, r.noise}].push_back(&r);
   std::ostringstream o;
@@ -157,6 +157,10 @@ std::string summary(const std::string& suite, const std::vector<Row>& rows) {
   for (const auto& [key, f] : families)
     o << "| " << key.first << " | " << key.second << " | " << f[0] + f[1] + f[2] + f[3] << " | " << f[0] << " | "
       << f[1] << " | " << f[2] << " | " << f[3] << " |\n";
+  if (!skipped.empty()) {
+    o << "\nSkipped (no pair to match, not counted above):\n";
+    for (const auto& s : skipped) o << "- " << s << "\n";
+  }
   if (times.count("tomomap") && times.count("fpfh-ransac")) {
     o << std::setprecision(1) << "\nfpfh-ransac / tomomap: median time "
       << quantile(times["fpfh-ransac"], 0.5) / quantile(times["tomomap"], 0.5) << "x, peak memory "
@@ -236,6 +240,9 @@ int runEval(const EvalOptions& o) {
         suite.pairs.push_back({name, w.maps[0], w.maps[1], w.poses[0], w.poses[1], grid, noise,
                                y.world + " g" + shortNumber(grid) + variant, y.methods});
       }
+  // A seed whose cut leaves too small a crop is no pair: said and skipped, so
+  // one seed does not end a run of hundreds (a scan that cannot be read still does).
+  std::vector<std::string> skipped;
   for (const auto& c : suite.scans)
     for (int64_t seed : c.seeds) {
       synth::ScanPairParams params;
@@ -243,7 +250,14 @@ int runEval(const EvalOptions& o) {
       const std::string folder = c.name + "-" + std::to_string(seed) + "-g" + shortNumber(c.grid);
       std::cerr << "cutting " << folder << " from " << c.file << "\n";
       std::string what;
-      const GeneratedWorld w = writeScanPair(c.file, params, (out / "worlds" / folder).string(), &what);
+      GeneratedWorld w;
+      try {
+        w = writeScanPair(c.file, params, (out / "worlds" / folder).string(), &what);
+      } catch (const synth::SmallCrop& e) {
+        skipped.push_back(folder + ": " + e.what());
+        std::cerr << "tomomap eval: warning: skipping " << skipped.back() << "\n";
+        continue;
+      }
       suite.pairs.push_back({folder + "-" + what, w.maps[0], w.maps[1], w.poses[0], w.poses[1], c.grid, "real",
                              c.name + " g" + shortNumber(c.grid), c.methods});
     }
@@ -294,7 +308,7 @@ int runEval(const EvalOptions& o) {
                 << " rad  " << std::setprecision(2) << r.seconds << " s  " << std::setprecision(0) << r.peak_rss_mb
                 << " MB" << (r.note.empty() ? "" : "  (" + r.note + ")") << "\n";
     }
-  const std::string md = summary(suite.name, rows);
+  const std::string md = summary(suite.name, rows, skipped);
   std::ofstream(out / "summary.md") << md;
   viz::writePng((out / "boxplots.png").string(), boxPlots(rows, suite.methods));
   std::cout << md << "\nrows: " << (out / "rows.csv").string() << ", summary: " << (out / "summary.md").string()

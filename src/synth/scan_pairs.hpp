@@ -39,8 +39,15 @@ struct ScanPair {
   ScanPairInfo info;
 };
 
+/// A seed whose cut leaves a crop too small to be a map (the scan itself is
+/// fine: other seeds cut it). `tomomap eval` skips such a seed and says so.
+struct SmallCrop : InputError {
+  using InputError::InputError;
+};
+
 /// Cuts `scan` (finite points, z up) into an overlapping pair. Deterministic
-/// from params.seed. Throws InputError when the scan has too few points to cut.
+/// from params.seed. Throws InputError when the scan has too few points to cut,
+/// SmallCrop when this seed's cut leaves a crop of too few.
 ScanPair makeScanPair(const Points& scan, const ScanPairParams& params);
 
 /// "o35-thin6-src" style: what a reader needs to tell pairs of one scan apart.
