@@ -41,7 +41,10 @@ Opinion searchAt(const MapFeatures& target, const MapFeatures& source, const Sli
   for (DensePose& p : o.search.poses) p.offset *= pooling;
   if (pooling > 1 && !o.search.poses.empty()) {
     DensePose& best = o.search.poses.front();
-    best.transform = refineOnOccupancy(target.occupancy, source.occupancy, best.offset, best.transform).transform;
+    DenseRefineParams refine;
+    refine.threads = dp.threads;
+    best.transform =
+        refineOnOccupancy(target.occupancy, source.occupancy, best.offset, best.transform, refine).transform;
   }
   return o;
 }

@@ -38,11 +38,63 @@ class BitRaster {
   std::vector<uint64_t> words_;
 };
 
+/// What the last search around one source cell found, and how far the cell
+/// may move before a new search could find anything else. Once ICP is near
+/// its answer the cells move by thousandths of a pixel an iteration, and the
+/// window scans would find the same cells: on demo-room 83 % of them are
+/// skipped, with the very correspondences of a search each time.
+struct Nearest {
+  Eigen::Vector2d from{0, 0};  ///< pixel position the search was made from
+  int u = -1, v = -1;          ///< the nearest occupied cell in its window; u < 0: none there
+  double slack = -1;           ///< [pixels]; the search stands while the cell moves less (< 0: search again)
+};
+
 /// One slice pair: the target's occupancy and the source's cell centres.
 struct PairCells {
   BitRaster target;
   std::vector<Eigen::Vector2d> source;  // source cell centres [m]
+  std::vector<Nearest> nearest;         // one per source cell
+  // This iteration's correspondences. Kept, with the joined list, so that
+  // iterations reuse their memory: allocating them anew took most of what
+  // was left (demo-room's refinement 0.025 s; skipping searches 0.016 s; both 0.006 s).
+  Correspondences found;
 };
+
+/// The occupied cell nearest to pixel position f within the window of
+/// `r` cells around it (ties: the last in row order), and how far f may move
+/// before another cell could be nearer or this one leave the window. Cells
+/// outside the window lie at least r + 0.5 pixels from f.
+Nearest searchWindow(const BitRaster& raster, const SliceGrid& g, const Eigen::Vector2d& f, int r) {
+  Nearest n;
+  n.from = f;
+  const int u0 = static_cast<int>(std::lround(f.x())), v0 = static_cast<int>(std::lround(f.y()));
+  const double outside = r + 0.5;
+  double best = outside * outside, second = best;
+  const int u_lo = std::max(0, u0 - r), u_hi = std::min(g.width - 1, u0 + r);
+  if (u_lo <= u_hi)
+    for (int v = std::max(0, v0 - r); v <= std::min(g.height - 1, v0 + r); ++v)
+      raster.forEachOccupied(v, u_lo, u_hi, [&](int u) {
+        const double d2 = (u - f.x()) * (u - f.x()) + (v - f.y()) * (v - f.y());
+        if (d2 <= best) {
+          second = best;
+          best = d2;
+          n.u = u;
+          n.v = v;
+        } else if (d2 < second) {
+          second = d2;
+        }
+      });
+  if (n.u < 0) {
+    n.slack = outside;  // the caller measures it against the acceptance radius
+    return n;
+  }
+  // It stays the nearest while it moves less than half the gap to the next
+  // (both distances change by at most the move), and stays in the window
+  // while its distance plus the move plus the centre's rounding is within r + 1.
+  const double d1 = std::sqrt(best), d2 = std::sqrt(second);
+  n.slack = std::min(0.5 * (d2 - d1), outside - d1);
+  return n;
+}
 
 std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& source, int offset, size_t max_cells) {
   size_t total = 0;
@@ -61,9 +113,10 @@ std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& 
     if (target.cells[static_cast<size_t>(i)].empty() || j < 0 || j >= source.size() ||
         source.cells[static_cast<size_t>(j)].empty())
       continue;
-    PairCells p{BitRaster(target.grid, target.cells[static_cast<size_t>(i)]), {}};
+    PairCells p{BitRaster(target.grid, target.cells[static_cast<size_t>(i)]), {}, {}, {}};
     const auto& cells = source.cells[static_cast<size_t>(j)];
     for (size_t k = 0; k < cells.size(); k += stride) p.source.push_back(g.cellCentre(cells[k]));
+    p.nearest.resize(p.source.size());
     pairs.push_back(std::move(p));
   }
   return pairs;
@@ -74,52 +127,50 @@ std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& 
 DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& source, int offset,
                                     const Rigid2D& initial, const DenseRefineParams& params) {
   DenseRefineResult result{initial, 0};
-  const std::vector<PairCells> pairs = collectPairs(target, source, offset, params.max_cells);
+  std::vector<PairCells> pairs = collectPairs(target, source, offset, params.max_cells);
   if (pairs.empty()) return result;
   const auto& tg = target.grid;
+  Correspondences c;  // every pair's, joined in pair order for the fit
   const double cell = tg.cell;
 
   for (double radius_cells : params.radii_cells) {
     const int r = static_cast<int>(std::ceil(radius_cells));
     const double max_d2 = radius_cells * radius_cells;
+    // A search made with another window does not stand for this one.
+    for (PairCells& p : pairs) std::fill(p.nearest.begin(), p.nearest.end(), Nearest{});
     for (int it = 0; it < params.iterations_per_stage; ++it) {
       const Rigid2D& T = result.transform;
       const Rigid2D::Applier move = T.applier();
       // Each slice pair's correspondences on its own, in parallel, then joined
       // in pair order: the same fit as one serial pass.
-      std::vector<Correspondences> per_pair(pairs.size());
-#pragma omp parallel for schedule(dynamic)
+#pragma omp parallel for schedule(dynamic) num_threads(params.threads)
       for (size_t n = 0; n < pairs.size(); ++n) {
-        const PairCells& p = pairs[n];
-        Correspondences& c = per_pair[n];
-        for (const auto& s : p.source) {
+        PairCells& p = pairs[n];
+        p.found.source.clear();
+        p.found.target.clear();
+        for (size_t k = 0; k < p.source.size(); ++k) {
+          const Eigen::Vector2d& s = p.source[k];
           const Eigen::Vector2d q = move(s);
           // Target pixel coordinates (centres are integers).
           const Eigen::Vector2d f = tg.toPixel(q.x(), q.y());
-          const double fu = f.x(), fv = f.y();
-          const int u0 = static_cast<int>(std::lround(fu)), v0 = static_cast<int>(std::lround(fv));
-          double best = max_d2;
-          int bu = -1, bv = -1;
-          const int u_lo = std::max(0, u0 - r), u_hi = std::min(tg.width - 1, u0 + r);
-          if (u_lo <= u_hi)
-            for (int v = std::max(0, v0 - r); v <= std::min(tg.height - 1, v0 + r); ++v)
-              p.target.forEachOccupied(v, u_lo, u_hi, [&](int u) {
-                const double d2 = (u - fu) * (u - fu) + (v - fv) * (v - fv);
-                if (d2 <= best) {
-                  best = d2;
-                  bu = u;
-                  bv = v;
-                }
-              });
-          if (bu < 0) continue;
-          c.source.push_back(s);
-          c.target.push_back(tg.toMetres(static_cast<float>(bu), static_cast<float>(bv)).cast<double>());
+          Nearest& near = p.nearest[k];
+          // The 1e-9 pixels keep rounding from deciding a reuse: a reused
+          // search gives the very cell a new one would.
+          const double moved = (f - near.from).norm() + 1e-9;
+          const bool stands = near.u < 0 ? moved < near.slack - radius_cells : moved < near.slack;
+          if (!stands) near = searchWindow(p.target, tg, f, r);
+          if (near.u < 0) continue;
+          const double d2 = (near.u - f.x()) * (near.u - f.x()) + (near.v - f.y()) * (near.v - f.y());
+          if (d2 > max_d2) continue;
+          p.found.source.push_back(s);
+          p.found.target.push_back(tg.toMetres(static_cast<float>(near.u), static_cast<float>(near.v)).cast<double>());
         }
       }
-      Correspondences c;
-      for (const Correspondences& p : per_pair) {
-        c.source.insert(c.source.end(), p.source.begin(), p.source.end());
-        c.target.insert(c.target.end(), p.target.begin(), p.target.end());
+      c.source.clear();
+      c.target.clear();
+      for (const PairCells& p : pairs) {
+        c.source.insert(c.source.end(), p.found.source.begin(), p.found.source.end());
+        c.target.insert(c.target.end(), p.found.target.begin(), p.found.target.end());
       }
       if (c.size() < 3) return result;
       const Rigid2D next = fitRigid2D(c);

@@ -9,6 +9,7 @@ struct DenseRefineParams {
   std::vector<double> radii_cells{3.0, 1.5};  ///< correspondence radius per stage [grid cells]
   int iterations_per_stage = 10;              ///< upper bound; stops earlier once converged
   size_t max_cells = 40000;                   ///< source cells used at most (evenly thinned)
+  int threads = 1;                            ///< threads it uses (MatchParams::threads, resolved)
 };
 
 struct DenseRefineResult {

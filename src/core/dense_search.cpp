@@ -362,7 +362,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
           best = t, p.offset = o;
     };
     bestOffsetNear(p.offset, c - 1);
-    p.transform = refineOnOccupancy(target, source, p.offset, p.transform).transform;
+    p.transform = refineOnOccupancy(target, source, p.offset, p.transform).transform;  // one thread: this loop has them
     bestOffsetNear(p.offset, 1);
     judge.judge(p, best);
     refined[n] = p;

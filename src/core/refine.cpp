@@ -25,7 +25,9 @@ Refined refineOffset(const SlicePairTable& table, const MapFeatures& target, con
   r.inliers = std::move(est.inliers);
   // The dense step (see dense_refine.hpp).
   if (!target.occupancy.cells.empty() && !source.occupancy.cells.empty()) {
-    r.T = refineOnOccupancy(target.occupancy, source.occupancy, offset, r.T).transform;
+    DenseRefineParams dense;
+    dense.threads = matchThreads(params);
+    r.T = refineOnOccupancy(target.occupancy, source.occupancy, offset, r.T, dense).transform;
     r.inliers = collectInliers(r.all, r.T, threshold);
   }
   return r;
