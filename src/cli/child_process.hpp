@@ -9,6 +9,7 @@ namespace tomomap::cli {
 struct ChildRun {
   int exit_code = -1;      ///< -1 if it did not exit normally (signal)
   double seconds = 0;      ///< wall time
+  double cpu_seconds = 0;  ///< user and system time of all its threads
   double peak_rss_mb = 0;  ///< maximum resident set size
   std::string output;      ///< stdout and stderr together
   bool timed_out = false;  ///< killed after the time limit

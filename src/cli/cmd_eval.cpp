@@ -36,21 +36,21 @@ struct Row {
   std::string pair, noise, family, method;
   int exit_code = -1;
   bool reliable = false, success = false;
-  double grid = 0, translation_error = NAN, yaw_error = NAN, seconds = 0, peak_rss_mb = 0;
+  double grid = 0, translation_error = NAN, yaw_error = NAN, seconds = 0, cpu_seconds = 0, peak_rss_mb = 0;
   double features = 0, slices = 0, payload_bytes = 0, raw_bytes = 0;
   std::string note;
 };
 
 const char* kCsvHeader =
-    "pair,noise,family,method,exit_code,reliable,success,translation_error_m,yaw_error_rad,wall_s,peak_rss_mb,features,"
-    "feature_payload_bytes,raw_map_bytes,note";
+    "pair,noise,family,method,exit_code,reliable,success,translation_error_m,yaw_error_rad,wall_s,cpu_s,peak_rss_mb,"
+    "features,feature_payload_bytes,raw_map_bytes,note";
 
 std::string csv(const Row& r) {
   std::ostringstream o;
   o << std::setprecision(6) << '"' << r.pair << "\"," << r.noise << ",\"" << r.family << "\"," << r.method << ','
     << r.exit_code << ',' << r.reliable << ',' << r.success << ',' << r.translation_error << ',' << r.yaw_error << ','
-    << r.seconds << ',' << r.peak_rss_mb << ',' << r.features << ',' << r.payload_bytes << ',' << r.raw_bytes << ",\""
-    << r.note << '"';
+    << r.seconds << ',' << r.cpu_seconds << ',' << r.peak_rss_mb << ',' << r.features << ',' << r.payload_bytes << ','
+    << r.raw_bytes << ",\"" << r.note << '"';
   return o.str();
 }
 
@@ -82,6 +82,7 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   const ChildRun run = runChild(argv, timeout_s);
   row.exit_code = run.exit_code;
   row.seconds = run.seconds;
+  row.cpu_seconds = run.cpu_seconds;
   row.peak_rss_mb = run.peak_rss_mb;
   if (run.timed_out) {
     row.note = "timed out after " + shortNumber(timeout_s) + " s";
@@ -291,6 +292,7 @@ int runEval(const EvalOptions& o) {
                                   {"yaw_error_rad",
                                    std::isnan(r.yaw_error) ? nlohmann::json() : nlohmann::json(r.yaw_error)},
                                   {"wall_s", r.seconds},
+                                  {"cpu_s", r.cpu_seconds},
                                   {"peak_rss_mb", r.peak_rss_mb},
                                   {"features", r.features},
                                   {"feature_payload_bytes", r.payload_bytes},

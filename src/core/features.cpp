@@ -1,5 +1,7 @@
 #include "features.hpp"
 
+#include <omp.h>
+
 #include <utility>
 
 namespace tomomap {
@@ -22,14 +24,14 @@ cv::Ptr<cv::ORB> sliceDetector(const FeatureParams& params) {
   return cv::ORB::create(params.max_features, 1.2f, 1, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31, params.fast_threshold);
 }
 
-MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params) {
+MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params, int threads) {
   MapFeatures out;
   out.grid = stack.grid.cell;
   out.z_min = stack.grid.z_min;
   out.slice_count = stack.size();
   std::vector<SliceFeatures> per_slice(static_cast<size_t>(stack.size()));
 
-#pragma omp parallel for schedule(dynamic)
+#pragma omp parallel for schedule(dynamic) num_threads(threads > 0 ? threads : omp_get_max_threads())
   for (int k = 0; k < stack.size(); ++k) {
     if (stack.cells[static_cast<size_t>(k)].empty()) continue;
     // Only the occupied part of the raster, padded: the same keypoints and

@@ -49,8 +49,9 @@ inline double heightShift(const MapFeatures& target, const MapFeatures& source, 
 /// metric and there is no scale to search over. Not thread-safe to share.
 cv::Ptr<cv::ORB> sliceDetector(const FeatureParams& params);
 
-/// Detects ORB on every non-empty slice. Parallel over slices. The stack moves
-/// into the result's `occupancy` (pass a copy to keep your own).
-MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params = {});
+/// Detects ORB on every non-empty slice, in parallel over slices on `threads`
+/// threads (0: every core). The stack moves into the result's `occupancy`
+/// (pass a copy to keep your own).
+MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params = {}, int threads = 0);
 
 }  // namespace tomomap

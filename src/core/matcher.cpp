@@ -123,17 +123,18 @@ std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string
 MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings, size_t* filtered_points) {
   StageTimings local;
   StageTimings& t = timings ? *timings : local;
+  const int threads = matchThreads(params);
   // The tilt is measured beside the voxel filter and slicing (it reads the raw
   // points alone, and took as long as both on a street): the map is sliced
   // before the tilt is known, and sliced again in the rare case it is levelled.
   // From the raw points: the filter's grid would bias a leaning plane's normals towards the axes.
-  std::future<Tilt> tilt_estimate = std::async(matchThreads(params) > 1 ? std::launch::async : std::launch::deferred,
+  std::future<Tilt> tilt_estimate = std::async(threads > 1 ? std::launch::async : std::launch::deferred,
                                                [&] { return estimateTilt(map, params.grid); });
   auto t0 = Clock::now();
   Points filtered = voxelFilter(map, params.grid);
   t.voxel += secondsSince(t0);
   t0 = Clock::now();
-  SliceStack stack = makeSlices(filtered, params.grid);
+  SliceStack stack = makeSlices(filtered, params.grid, threads);
   const Tilt tilt = tilt_estimate.get();
   // Only a map that would be refused: levelling a level map by the estimate's
   // own error (0.6 deg on demo-pcd1) cost 3 cm and 0.6 deg on demo-room.
@@ -142,12 +143,12 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   if (level) {
     // The levelled map is filtered again: rotated voxels no longer sit on the grid.
     filtered = voxelFilter(rotatePoints(filtered, tilt.leveling()), params.grid);
-    stack = makeSlices(filtered, params.grid);
+    stack = makeSlices(filtered, params.grid, threads);
   }
   if (filtered_points) *filtered_points = filtered.size();
   t.slicing += secondsSince(t0);
   t0 = Clock::now();
-  MapFeatures f = extractFeatures(std::move(stack), params.features);
+  MapFeatures f = extractFeatures(std::move(stack), params.features, threads);
   t.features += secondsSince(t0);
   f.tilt = tilt;
   f.leveled = level;

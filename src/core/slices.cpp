@@ -1,5 +1,7 @@
 #include "slices.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <optional>
 
@@ -31,7 +33,7 @@ cv::Rect SliceStack::occupiedArea(int k) const {
   return {static_cast<int>(u0), static_cast<int>(v0), static_cast<int>(u1 - u0 + 1), static_cast<int>(v1 - v0 + 1)};
 }
 
-SliceStack makeSlices(const Points& points, double cell) {
+SliceStack makeSlices(const Points& points, double cell, int threads) {
   if (!(cell > 0.0)) throw InputError("grid size must be positive");
   SliceStack stack;
   if (points.empty()) return stack;
@@ -92,7 +94,7 @@ SliceStack makeSlices(const Points& points, double cell) {
   const size_t raster_words = (static_cast<size_t>(g.width) * static_cast<size_t>(g.height) + 63) / 64;
   auto& cells = stack.cells;
   cells.resize(slices);
-#pragma omp parallel
+#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads())
   {
     std::vector<uint64_t> marked(raster_words);
 #pragma omp for schedule(dynamic)

@@ -58,8 +58,8 @@ constexpr int kMaxImageSide = 16384;
 /// bounds (stray returns left out and counted). Slices with fewer
 /// occupied cells than (width + height) / 2 are kept empty (too sparse for ORB);
 /// empty slices at the bottom and top are trimmed. Throws InputError if the
-/// raster would exceed kMaxImageSide.
-SliceStack makeSlices(const Points& points, double cell);
+/// raster would exceed kMaxImageSide. Uses `threads` threads (0: every core).
+SliceStack makeSlices(const Points& points, double cell, int threads = 0);
 
 /// The same occupancy at twice the cell: each 2 x 2 block of cells and each
 /// two slices become one (a cell occupied where any of its eight was). Pooled
