@@ -135,11 +135,7 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
       case Verdict::Needs::pooled_search:
         at_pooled = searchAt(target, source, pooled(target.occupancy), pooled(source.occupancy), 2, params);
         e.pooled = evidenceOf(*at_pooled, r, features, target, source);
-        if (at_pooled->found()) {
-          r.dense_pooled_lead = e.pooled->lead();
-          e.pooled_at_grid_best = at_grid && at_grid->found() &&
-                                  isBestPose(*at_pooled, at_grid->best().transform, at_grid->best().offset, source);
-        }
+        if (at_pooled->found()) r.dense_pooled_lead = e.pooled->lead();
         break;
       case Verdict::Needs::nothing:
         break;

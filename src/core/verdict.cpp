@@ -34,12 +34,6 @@ constexpr double kDenseOpinion = 1.2;
 /// Pooled occupancy is searched only where its cell stays this fine [m]
 /// (maps at g 0.1 and finer): room pairs were measured up to there.
 constexpr double kCoarsestPooledCell = 0.2;
-/// Where neither search answers alone, the map's grid and pooled occupancy
-/// agreeing on a best pose is an answer when the grid's leads by
-/// kDenseOpinion and the pooled one by this. On the 304 room pairs (of 820)
-/// neither answered alone, the wrong poses both agreed on led by at most
-/// 1.19x and 1.08x.
-constexpr double kPooledAgreement = 1.1;
 
 /// Why the features' answer is no reliable match on its own; empty if it is one.
 std::string featureRefusal(const FeatureEvidence& f, const MatchParams& params) {
@@ -181,17 +175,18 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
            contradictionNote(grid);
   }
 
-  // The pooled search answers with a clear pose, or with the grid's where the
-  // two agree; it does not confirm the features' answer: on a held-out room
-  // (seed 203, high noise, g 0.05) it confirmed one 0.27 m off in height,
-  // within the smear a confirmation allows.
+  // The pooled search answers with a clear pose of its own; it does not
+  // confirm the features' answer: on a held-out room (seed 203, high noise,
+  // g 0.05) it confirmed one 0.27 m off in height, within the smear a
+  // confirmation allows. Nor does it answer by agreeing with the grid's best
+  // pose short of a clear lead: that rule answered none of 1,088 pairs (rooms
+  // seeds 1-200 at g 0.05 and 0.1, the building at g 0.2, the regression
+  // matrix, fresh real-scan seeds) once the wide search came before it.
   if (2 * e.grid > kCoarsestPooledCell + 1e-9) return none(why);
   if (!e.pooled) return needs(Verdict::Needs::pooled_search);
   const DenseEvidence& pooled = *e.pooled;
   if (!pooled.found) return none(why);
   if (leads(pooled, kDenseLead, params)) return by(Verdict::By::pooled);
-  if (leads(grid, kDenseOpinion, params) && leads(pooled, kPooledAgreement, params) && e.pooled_at_grid_best)
-    return by(Verdict::By::at_grid);
   return none(why + "; at " + fixed(pooled.cell, 2) +
               " m cells its best pose: " + shortfall(pooled, kDenseLead, params) + contradictionNote(pooled));
 }

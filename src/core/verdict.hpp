@@ -71,7 +71,6 @@ struct Evidence {
   std::optional<DenseEvidence> wide;         ///< the same on a raster twice as fine (kWideCoarseSide)
   std::optional<DensePose> features_landed;  ///< the features' answer landed on the maps' own occupancy
   std::optional<DenseEvidence> pooled;       ///< the dense search on occupancy pooled to twice the cell
-  bool pooled_at_grid_best = false;          ///< the pooled search's best pose is the grid search's
 };
 
 struct Verdict {
@@ -95,8 +94,7 @@ struct Verdict {
 /// place of its own, and the features' answer then stands if its own landing
 /// holds. A match the features did not answer is answered by a clear dense
 /// pose. Where that leaves no answer and the pooled cell stays fine enough,
-/// the search on pooled occupancy answers with a clear pose of its own, or
-/// with the grid's where the two agree. Every lead must also be beyond chance
+/// the search on pooled occupancy answers with a clear pose of its own. Every lead must also be beyond chance
 /// (kSignificant) and its pose hold (kMostContradicted, min_support slices).
 Verdict decideMatch(const Evidence& e, const MatchParams& params);
 
