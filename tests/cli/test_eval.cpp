@@ -125,7 +125,7 @@ TEST(Eval, ASeedThatCutsTooSmallACropIsSkippedAndSaidAndTheRestRuns) {
 // `-j 1` is one thread for every stage of a match (slicing, features and the
 // dense refinement once took every core whatever it said): each run's
 // processor time stays within its wall time. On a busy machine a run on two
-// threads could pass too; on an idle one it spent 1.3x its wall time.
+// threads could pass too; on an idle one it spent 1.4x its wall time.
 TEST(Eval, OneThreadAskedKeepsEachRunOnOneCore) {
   TempDir dir;
   std::ofstream(dir / "s.toml") << "name = \"one\"\nmethods = [\"tomomap\"]\n[[synth]]\nworld = \"room\"\n"
