@@ -44,6 +44,38 @@ void sortByCell(Words& words, uint64_t cells, Words& scratch) {
   }
 }
 
+/// One cell's running sum, for binning in place.
+struct CellSum {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  uint32_t points = 0;
+};
+
+/// Bins the points `first` to `last` name (indices into `in`, ascending) into
+/// `sums`, one per cell of a layer (`cellOf` numbers them from 0), and
+/// appends their centroids in cell order: what sorting them by cell gives,
+/// summed in the same order, bit for bit, in one pass. `sums` and `occupied`
+/// (a bit per cell) are left cleared for the next layer.
+template <typename CellOf>
+void appendBinnedInPlace(const Points& in, const uint32_t* first, const uint32_t* last, CellOf cellOf,
+                         std::vector<CellSum>& sums, std::vector<uint64_t>& occupied, Points& out) {
+  size_t lo = occupied.size(), hi = 0;
+  for (const uint32_t* k = first; k != last; ++k) {
+    const uint64_t c = cellOf(in[*k]);
+    sums[c].sum += in[*k].cast<double>();
+    ++sums[c].points;
+    occupied[c / 64] |= uint64_t{1} << (c % 64);
+    lo = std::min<size_t>(lo, c / 64), hi = std::max<size_t>(hi, c / 64);
+  }
+  for (size_t w = lo; w <= hi && lo < occupied.size(); ++w) {
+    for (uint64_t bits = occupied[w]; bits != 0; bits &= bits - 1) {
+      CellSum& s = sums[w * 64 + static_cast<size_t>(__builtin_ctzll(bits))];
+      out.push_back((s.sum / static_cast<double>(s.points)).cast<float>());
+      s = CellSum{};
+    }
+    occupied[w] = 0;
+  }
+}
+
 }  // namespace
 
 Points voxelFilter(const Points& in, double leaf) {
@@ -70,13 +102,13 @@ Points voxelFilter(const Points& in, double leaf) {
   Points out;
   out.reserve(in.size());
 
+  const uint64_t layer_cells = nx * ny;
   // Most maps have under 2^32 cells in a layer: cell and point then share one
   // 64-bit word. The points are first grouped by layer (a counting sort of
   // their indices, ascending within a layer), then one layer's words at a time
   // are sorted by radix: beside the raw points, 4 bytes a point and one
   // layer's words, not 16 bytes a point (the whole map's words and the radix
   // sort's second buffer).
-  const uint64_t layer_cells = nx * ny;
   if (layer_cells <= (uint64_t{1} << 32) && in.size() < (uint64_t{1} << 32)) {
     std::vector<uint32_t> first(nz + 1, 0);  // each layer's start in `by_layer`
     for (const auto& p : in) ++first[index(p.z() - lo.z()) + 1];
@@ -85,6 +117,19 @@ Points voxelFilter(const Points& in, double leaf) {
     {
       std::vector<uint32_t> next(first.begin(), first.end() - 1);
       for (uint32_t i = 0; i < in.size(); ++i) by_layer[next[index(in[i].z() - lo.z())]++] = i;
+    }
+    // A layer of no more cells than the map has points is binned in place (32
+    // bytes a cell) rather than sorted: the building's map (1.85 M points) at
+    // g 0.2 in 0.016 s instead of 0.023, at 0.1 in 0.018 (0.025); at 0.05 (134 k
+    // cells a layer) as fast as sorting, 0.028 s.
+    if (layer_cells <= in.size()) {
+      std::vector<CellSum> sums(layer_cells);
+      std::vector<uint64_t> occupied((layer_cells + 63) / 64, 0);
+      for (uint64_t z = 0; z < nz; ++z)
+        appendBinnedInPlace(
+            in, by_layer.data() + first[z], by_layer.data() + first[z + 1],
+            [&](const Eigen::Vector3f& p) { return cellOf(p) - z * layer_cells; }, sums, occupied, out);
+      return out;
     }
     uint32_t largest = 0;
     for (size_t z = 0; z < nz; ++z) largest = std::max(largest, first[z + 1] - first[z]);

@@ -30,14 +30,19 @@ TEST(VoxelFilter, HandlesExtentsThatOverflow32BitCellCounts) {
 TEST(VoxelFilter, RejectsNonPositiveLeaf) { EXPECT_THROW(voxelFilter({{0, 0, 0}}, 0.0), InputError); }
 
 // The centroids, in cell order (z, then y, then x) and summed in point order,
-// as a plain map of cells computes them: the filter sorts one layer at a time,
-// which must not change a bit.
-TEST(VoxelFilter, GivesWhatAPlainMapOfCellsGivesBitForBit) {
+// as a plain map of cells computes them: the filter bins a layer in place, or
+// sorts it where the layer has more cells than the map has points, which must
+// not change a bit.
+class VoxelFilterPaths : public ::testing::TestWithParam<float> {};
+
+TEST_P(VoxelFilterPaths, GiveWhatAPlainMapOfCellsGivesBitForBit) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> x(-3.f, 5.f), z(-0.4f, 2.6f);
   Points in(200000);
   for (auto& p : in) p = {x(rng), x(rng), z(rng)};
-  in.push_back({40.f, 40.f, 0.f});  // a far point: many empty layers and columns
+  // A far point: many empty layers and columns. At 15 m, 130 k cells a layer
+  // (binned in place: under the 200 k points); at 400 m, 64 M (sorted).
+  in.push_back({GetParam(), GetParam(), 0.f});
   const float leaf = 0.05f;
   Eigen::Vector3f lo = in.front();
   for (const auto& p : in) lo = lo.cwiseMin(p);
@@ -58,6 +63,8 @@ TEST(VoxelFilter, GivesWhatAPlainMapOfCellsGivesBitForBit) {
     ++k;
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(VoxelFilter, VoxelFilterPaths, ::testing::Values(15.f, 400.f));
 
 TEST(VoxelFilter, HandlesLayersOfMoreThan32BitCells) {
   // 300 km x 300 km at 0.05 m: more than 2^32 cells in one layer, sorted whole.
