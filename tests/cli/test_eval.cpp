@@ -17,6 +17,20 @@ using tomomap::test::keysOf;
 using tomomap::test::runTomomap;
 using tomomap::test::TempDir;
 
+/// Writes `suite` as DIR/s.toml and runs `tomomap eval` on it into DIR/out, with `options`.
+static test::CommandResult evalSuite(const TempDir& dir, const std::string& suite, const std::string& options = "") {
+  std::ofstream(dir / "s.toml") << suite;
+  return runTomomap("eval " + (dir / "s.toml") + (options.empty() ? "" : " " + options) + " -o " + (dir / "out"));
+}
+
+/// DIR/out/rows.jsonl, a row each.
+static std::vector<nlohmann::json> jsonRows(const TempDir& dir) {
+  std::ifstream jsonl(dir / "out/rows.jsonl");
+  std::vector<nlohmann::json> rows;
+  for (std::string line; std::getline(jsonl, line);) rows.push_back(nlohmann::json::parse(line));
+  return rows;
+}
+
 static std::string slurp(const std::string& path) {
   std::ifstream in(path);
   std::stringstream s;
@@ -49,14 +63,13 @@ TEST(Eval, MissingMapIsLeftOutAndTheRestRuns) {
   REQUIRE_DEMO_ROOM();
   TempDir dir;
   const std::string d = test::demoRoom() + "/";
-  std::ofstream(dir / "s.toml") << "name = \"mixed\"\nmethods = [\"tomomap\"]\n"
-                                << "[[pair]]\nname = \"gone\"\ntarget = \"/nonexistent/a.pcd\"\nsource = \"" << d
-                                << "demo-pcd2.pcd\"\ngt_target = \"" << d << "demo-pcd1-gtpose.txt\"\ngt_source = \""
-                                << d << "demo-pcd2-gtpose.txt\"\n"
-                                << "[[pair]]\nname = \"room\"\ntarget = \"" << d << "demo-pcd1.pcd\"\nsource = \"" << d
-                                << "demo-pcd2.pcd\"\ngt_target = \"" << d << "demo-pcd1-gtpose.txt\"\ngt_source = \""
-                                << d << "demo-pcd2-gtpose.txt\"\ngrid = 0.05\n";
-  const auto r = runTomomap("eval " + (dir / "s.toml") + " -o " + (dir / "out"));
+  const std::string truth =
+      "gt_target = \"" + d + "demo-pcd1-gtpose.txt\"\ngt_source = \"" + d + "demo-pcd2-gtpose.txt\"\n";
+  const auto r = evalSuite(dir,
+                           "name = \"mixed\"\nmethods = [\"tomomap\"]\n[[pair]]\nname = \"gone\"\n"
+                           "target = \"/nonexistent/a.pcd\"\nsource = \"" +
+                               d + "demo-pcd2.pcd\"\n" + truth + "[[pair]]\nname = \"room\"\ntarget = \"" + d +
+                               "demo-pcd1.pcd\"\nsource = \"" + d + "demo-pcd2.pcd\"\n" + truth + "grid = 0.05\n");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("pair 'gone' left out"), std::string::npos) << r.output;
   const std::string rows = slurp(dir / "out/rows.csv");
@@ -72,11 +85,9 @@ TEST(Eval, AScanBlockCutsPairsWithGroundTruthAndCountsRightRefusedWrong) {
   TempDir dir;
   const auto gen = runTomomap("synth -w room -s 2 --noise low -o " + (dir / "room"));
   ASSERT_EQ(gen.exit_code, 0) << gen.output;
-  std::ofstream(dir / "s.toml") << "name = \"scans\"\nmethods = [\"tomomap\"]\n"
-                                << "[[scan]]\nfile = \"room/map_0.pcd\"\nname = \"room-scan\"\nseeds = [1, 2]\n"
-                                << "grid = 0.1\n"
-                                << "[[scan]]\nfile = \"nowhere/scan.pcd\"\n";
-  const auto r = runTomomap("eval " + (dir / "s.toml") + " -o " + (dir / "out"));
+  const auto r = evalSuite(dir,
+                           "name = \"scans\"\nmethods = [\"tomomap\"]\n[[scan]]\nfile = \"room/map_0.pcd\"\n"
+                           "name = \"room-scan\"\nseeds = [1, 2]\ngrid = 0.1\n[[scan]]\nfile = \"nowhere/scan.pcd\"\n");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("scan 'scan' left out: "), std::string::npos) << r.output;
   const auto pair = nlohmann::json::parse(slurp(dir / "out/worlds/room-scan-1-g0.1/pair.json"));
@@ -108,9 +119,9 @@ TEST(Eval, ASeedThatCutsTooSmallACropIsSkippedAndSaidAndTheRestRuns) {
       xyz << x << " " << y << " " << z << "\n";
     }
   }
-  std::ofstream(dir / "s.toml") << "name = \"small\"\nmethods = [\"tomomap\"]\n"
-                                << "[[scan]]\nfile = \"small.xyz\"\nname = \"small\"\nseeds = [1, 2]\ngrid = 0.1\n";
-  const auto r = runTomomap("eval " + (dir / "s.toml") + " -o " + (dir / "out"));
+  const auto r = evalSuite(dir,
+                           "name = \"small\"\nmethods = [\"tomomap\"]\n[[scan]]\nfile = \"small.xyz\"\n"
+                           "name = \"small\"\nseeds = [1, 2]\ngrid = 0.1\n");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("warning: skipping small-1-g0.1: cutting this scan left a crop of "), std::string::npos)
       << r.output;
@@ -128,18 +139,17 @@ TEST(Eval, ASeedThatCutsTooSmallACropIsSkippedAndSaidAndTheRestRuns) {
 // threads could pass too; on an idle one it spent 1.4x its wall time.
 TEST(Eval, OneThreadAskedKeepsEachRunOnOneCore) {
   TempDir dir;
-  std::ofstream(dir / "s.toml") << "name = \"one\"\nmethods = [\"tomomap\"]\n[[synth]]\nworld = \"room\"\n"
-                                << "seeds = [1, 2]\nnoise = [\"low\"]\ngrid = 0.05\n";
-  const auto r = runTomomap("eval " + (dir / "s.toml") + " -j 1 -o " + (dir / "out"));
+  const auto r = evalSuite(dir,
+                           "name = \"one\"\nmethods = [\"tomomap\"]\n[[synth]]\nworld = \"room\"\nseeds = [1, 2]\n"
+                           "noise = [\"low\"]\ngrid = 0.05\n",
+                           "-j 1");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  std::ifstream jsonl(dir / "out/rows.jsonl");
-  int rows = 0;
-  for (std::string line; std::getline(jsonl, line); ++rows) {
-    const auto row = nlohmann::json::parse(line);
-    EXPECT_GT(row["cpu_s"].get<double>(), 0.0) << line;
-    EXPECT_LE(row["cpu_s"].get<double>(), row["wall_s"].get<double>()) << line;
+  const auto rows = jsonRows(dir);
+  EXPECT_EQ(rows.size(), 2u);
+  for (const auto& row : rows) {
+    EXPECT_GT(row["cpu_s"].get<double>(), 0.0) << row.dump();
+    EXPECT_LE(row["cpu_s"].get<double>(), row["wall_s"].get<double>()) << row.dump();
   }
-  EXPECT_EQ(rows, 2);
 }
 
 // The CI suite shipped with the project: both world types, three noise levels,
@@ -169,9 +179,8 @@ TEST(Eval, CiSuiteSucceedsAndDrawsBoxPlots) {
 
 TEST(Eval, ASynthBlockMayNameOnlyTheSuitesMethods) {
   TempDir dir;
-  std::ofstream(dir / "s.toml") << "name = \"x\"\nmethods = [\"tomomap\"]\n[[synth]]\nworld = \"indoor\"\n"
-                                << "methods = [\"fpfh-ransac\"]\n";
-  const auto r = runTomomap("eval " + (dir / "s.toml") + " -o " + (dir / "out"));
+  const auto r = evalSuite(
+      dir, "name = \"x\"\nmethods = [\"tomomap\"]\n[[synth]]\nworld = \"indoor\"\nmethods = [\"fpfh-ransac\"]\n");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("s.toml:5:"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("not one of the suite's methods"), std::string::npos) << r.output;
@@ -180,21 +189,19 @@ TEST(Eval, ASynthBlockMayNameOnlyTheSuitesMethods) {
 TEST(Eval, ARunPastTheTimeoutIsKilledAndSaysSoAndTheSuiteGoesOn) {
   TempDir dir;
   // The baseline takes tens of seconds on this world; half a second is never enough.
-  std::ofstream(dir / "s.toml") << "name = \"t\"\nmethods = [\"fpfh-ransac\", \"tomomap\"]\n[[synth]]\nworld = "
-                                << "\"indoor\"\nseeds = [1]\nnoise = [\"low\"]\nscale = 0.5\ngrid = 0.1\n";
-  const auto r = runTomomap("eval " + (dir / "s.toml") + " --timeout 0.5 -o " + (dir / "out"));
+  const auto r = evalSuite(dir,
+                           "name = \"t\"\nmethods = [\"fpfh-ransac\", \"tomomap\"]\n[[synth]]\nworld = \"indoor\"\n"
+                           "seeds = [1]\nnoise = [\"low\"]\nscale = 0.5\ngrid = 0.1\n",
+                           "--timeout 0.5");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("[1/2] indoor-low-1-x0.5-g0.1 fpfh-ransac: running"), std::string::npos)
       << "said before it starts\n"
       << r.output;
-  std::ifstream jsonl(dir / "out/rows.jsonl");
-  std::string line;
-  ASSERT_TRUE(std::getline(jsonl, line));
-  const auto baseline = nlohmann::json::parse(line);
-  EXPECT_EQ(baseline["method"], "fpfh-ransac");
-  EXPECT_EQ(baseline["exit_code"], -1);
-  EXPECT_EQ(baseline["note"], "timed out after 0.5 s");
-  EXPECT_FALSE(baseline["success"].get<bool>());
-  ASSERT_TRUE(std::getline(jsonl, line));
-  EXPECT_EQ(nlohmann::json::parse(line)["method"], "tomomap") << "the next run still ran";
+  const auto rows = jsonRows(dir);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0]["method"], "fpfh-ransac");
+  EXPECT_EQ(rows[0]["exit_code"], -1);
+  EXPECT_EQ(rows[0]["note"], "timed out after 0.5 s");
+  EXPECT_FALSE(rows[0]["success"].get<bool>());
+  EXPECT_EQ(rows[1]["method"], "tomomap") << "the next run still ran";
 }
