@@ -94,8 +94,9 @@ struct Verdict {
 /// place of its own, and the features' answer then stands if its own landing
 /// holds. A match the features did not answer is answered by a clear dense
 /// pose. Where that leaves no answer and the pooled cell stays fine enough,
-/// the search on pooled occupancy answers with a clear pose of its own. Every lead must also be beyond chance
-/// (kSignificant) and its pose hold (kMostContradicted, min_support slices).
+/// the search on pooled occupancy answers with a clear pose of its own. Every
+/// lead must also be beyond chance (kSignificant) and its pose hold
+/// (kMostContradicted, min_support slices).
 Verdict decideMatch(const Evidence& e, const MatchParams& params);
 
 }  // namespace tomomap
