@@ -179,7 +179,7 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
   // confirm the features' answer: on a held-out room (seed 203, high noise,
   // g 0.05) it confirmed one 0.27 m off in height, within the smear a
   // confirmation allows. Nor does it answer by agreeing with the grid's best
-  // pose short of a clear lead: that rule answered none of 1,088 pairs (rooms
+  // pose short of a clear lead: that rule answered none of 1,488 pairs (rooms
   // seeds 1-200 at g 0.05 and 0.1, the building at g 0.2, the regression
   // matrix, fresh real-scan seeds) once the wide search came before it.
   if (2 * e.grid > kCoarsestPooledCell + 1e-9) return none(why);
