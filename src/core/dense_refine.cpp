@@ -46,7 +46,7 @@ class BitRaster {
 struct Nearest {
   Eigen::Vector2d from{0, 0};  ///< pixel position the search was made from
   int u = -1, v = -1;          ///< the nearest occupied cell in its window; u < 0: none there
-  double slack = -1;           ///< [pixels]; the search stands while the cell moves less (< 0: search again)
+  double slack = -1;           ///< [pixels]; the search stands while the cell moves less (<= 0: search again)
 };
 
 /// One slice pair: the target's occupancy and the source's cell centres.
@@ -61,10 +61,12 @@ struct PairCells {
 };
 
 /// The occupied cell nearest to pixel position f within the window of
-/// `r` cells around it (ties: the last in row order), and how far f may move
-/// before another cell could be nearer or this one leave the window. Cells
-/// outside the window lie at least r + 0.5 pixels from f.
-Nearest searchWindow(const BitRaster& raster, const SliceGrid& g, const Eigen::Vector2d& f, int r) {
+/// ceil(radius) cells around it (ties: the last in row order), and how far f
+/// may move before a new search could find another: another cell nearer,
+/// this one out of the window, or, where there is none, a cell within
+/// `radius`. Cells outside the window lie at least r + 0.5 pixels from f.
+Nearest searchWindow(const BitRaster& raster, const SliceGrid& g, const Eigen::Vector2d& f, double radius) {
+  const int r = static_cast<int>(std::ceil(radius));
   Nearest n;
   n.from = f;
   const int u0 = static_cast<int>(std::lround(f.x())), v0 = static_cast<int>(std::lround(f.y()));
@@ -85,7 +87,7 @@ Nearest searchWindow(const BitRaster& raster, const SliceGrid& g, const Eigen::V
         }
       });
   if (n.u < 0) {
-    n.slack = outside;  // the caller measures it against the acceptance radius
+    n.slack = outside - radius;
     return n;
   }
   // It stays the nearest while it moves less than half the gap to the next
@@ -134,7 +136,6 @@ DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& 
   const double cell = tg.cell;
 
   for (double radius_cells : params.radii_cells) {
-    const int r = static_cast<int>(std::ceil(radius_cells));
     const double max_d2 = radius_cells * radius_cells;
     // A search made with another window does not stand for this one.
     for (PairCells& p : pairs) std::fill(p.nearest.begin(), p.nearest.end(), Nearest{});
@@ -156,9 +157,7 @@ DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& 
           Nearest& near = p.nearest[k];
           // The 1e-9 pixels keep rounding from deciding a reuse: a reused
           // search gives the very cell a new one would.
-          const double moved = (f - near.from).norm() + 1e-9;
-          const bool stands = near.u < 0 ? moved < near.slack - radius_cells : moved < near.slack;
-          if (!stands) near = searchWindow(p.target, tg, f, r);
+          if (!((f - near.from).norm() + 1e-9 < near.slack)) near = searchWindow(p.target, tg, f, radius_cells);
           if (near.u < 0) continue;
           const double d2 = (near.u - f.x()) * (near.u - f.x()) + (near.v - f.y()) * (near.v - f.y());
           if (d2 > max_d2) continue;

@@ -1,8 +1,8 @@
 #include "features.hpp"
 
-#include <omp.h>
-
 #include <utility>
+
+#include "threads.hpp"
 
 namespace tomomap {
 
@@ -31,7 +31,7 @@ MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params, int t
   out.slice_count = stack.size();
   std::vector<SliceFeatures> per_slice(static_cast<size_t>(stack.size()));
 
-#pragma omp parallel for schedule(dynamic) num_threads(threads > 0 ? threads : omp_get_max_threads())
+#pragma omp parallel for schedule(dynamic) num_threads(resolvedThreads(threads))
   for (int k = 0; k < stack.size(); ++k) {
     if (stack.cells[static_cast<size_t>(k)].empty()) continue;
     // Only the occupied part of the raster, padded: the same keypoints and

@@ -1,12 +1,11 @@
 #include "slice_pairs.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <atomic>
 
 #include "hamming.hpp"
 #include "pair_cache.hpp"
+#include "threads.hpp"
 
 namespace tomomap {
 namespace {
@@ -26,7 +25,7 @@ Correspondences positions(const SliceFeatures& target, const SliceFeatures& sour
 
 }  // namespace
 
-int matchThreads(const MatchParams& params) { return params.threads > 0 ? params.threads : omp_get_max_threads(); }
+int matchThreads(const MatchParams& params) { return resolvedThreads(params.threads); }
 
 RansacParams ransacParams(const MatchParams& p) {
   RansacParams r;

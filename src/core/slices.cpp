@@ -1,12 +1,11 @@
 #include "slices.hpp"
 
-#include <omp.h>
-
 #include <algorithm>
 #include <optional>
 
 #include "map_bounds.hpp"
 #include "text.hpp"
+#include "threads.hpp"
 
 namespace tomomap {
 
@@ -94,7 +93,7 @@ SliceStack makeSlices(const Points& points, double cell, int threads) {
   const size_t raster_words = (static_cast<size_t>(g.width) * static_cast<size_t>(g.height) + 63) / 64;
   auto& cells = stack.cells;
   cells.resize(slices);
-#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads())
+#pragma omp parallel num_threads(resolvedThreads(threads))
   {
     std::vector<uint64_t> marked(raster_words);
 #pragma omp for schedule(dynamic)
