@@ -57,7 +57,8 @@ OwnMap describeLoaded(const Config& config, OwnMap own, const std::function<Poin
   const auto encoding = Clock::now();
   own.offer = transport::makeOffer(
       config.agent(), *features, config.match.features, binaryPcdBytes(own.cells),
-      transport::maxSampleBytes(config.transport.bandwidth_kbps, config.transport.security.enabled()));
+      transport::maxSampleBytes(config.transport.bandwidth_kbps, config.transport.security.enabled()),
+      config.match.threads);
   own.features = std::move(features);
   own.encoding = seconds(Clock::now() - encoding);
   own.seconds = seconds(Clock::now() - t0);

@@ -25,8 +25,9 @@ struct MatchedFiles {
 };
 
 /// Reads the ground truth first (so a bad pose file fails before minutes of
-/// work), then each map in turn (its raw points are dropped once described,
-/// which halves peak memory on large maps), then matches.
+/// work), then both maps at once, each on one thread, where params ask for
+/// two threads or more; with one, each map in turn (its raw points dropped
+/// once described: half the peak memory on large maps). Then matches.
 MatchedFiles matchFiles(MatchFilesOptions o);
 
 /// Adds --grid, --json, --gt-target, --gt-source, --features, -j, --max-tilt, --level, --exhaustive, --progress, -q.

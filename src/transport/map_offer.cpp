@@ -10,6 +10,7 @@
 #include "bundling.hpp"
 #include "core/dense_search.hpp"
 #include "core/match_settings.hpp"
+#include "core/threads.hpp"
 #include "slice_encoding.hpp"
 
 namespace tomomap::transport {
@@ -75,7 +76,7 @@ std::vector<wire::SliceFeatures> cutSlice(const std::string& agent, const SliceF
 }  // namespace
 
 MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const FeatureParams& params, uint64_t raw_bytes,
-                   size_t max_sample_bytes) {
+                   size_t max_sample_bytes, int threads) {
   const SliceGrid& g = f.occupancy.grid;
   const size_t header = sampleHeaderBytes(agent);
   const size_t room = max_sample_bytes > header + kFeatureBytes ? max_sample_bytes - header : kFeatureBytes;
@@ -110,9 +111,16 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const Feature
   // so that the receiver can search it too (it rebuilds the same features
   // from the cells); such maps are a few kilobytes either way.
   const bool cells_first = denseSearchable(f.occupancy);
-  for (const SliceFeatures* s : order) {
-    auto samples = cutSlice(agent, *s, f.occupancy.cells.at(static_cast<size_t>(s->index)), g, features_per_part,
-                            bytes_per_part, cells_first);
+  // Deflating each slice twice (slice_encoding.cpp) is most of the work: in
+  // parallel over slices, then put together in order.
+  std::vector<std::vector<wire::SliceFeatures>> cut(order.size());
+#pragma omp parallel for schedule(dynamic) num_threads(resolvedThreads(threads))
+  for (size_t i = 0; i < order.size(); ++i)
+    cut[i] = cutSlice(agent, *order[i], f.occupancy.cells.at(static_cast<size_t>(order[i]->index)), g,
+                      features_per_part, bytes_per_part, cells_first);
+  for (size_t i = 0; i < order.size(); ++i) {
+    const SliceFeatures* s = order[i];
+    auto& samples = cut[i];
     const auto bytes = canonicalBytes(samples);
     wire::SliceEntry e;
     e.slice(s->index);

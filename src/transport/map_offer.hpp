@@ -42,9 +42,10 @@ std::set<int> unchangedSlices(const wire::MapAnnouncement& now, const wire::MapA
 /// slice travels as features or as deflated occupancy, whichever is smaller;
 /// every slice as occupancy when the map is small enough for the dense search.
 /// `raw_bytes` is the binary PCD size of the voxel-filtered map, announced for
-/// the record. Most informative slices (most features) first.
+/// the record. Most informative slices (most features) first. Encodes on
+/// `threads` threads (0: every core).
 MapOffer makeOffer(const std::string& agent, const MapFeatures& features, const FeatureParams& params,
-                   uint64_t raw_bytes, size_t max_sample_bytes);
+                   uint64_t raw_bytes, size_t max_sample_bytes, int threads = 0);
 
 /// Hash of a map's raster, feature settings, slices and chunking: equal maps
 /// described alike and cut for equal budgets have equal versions.
