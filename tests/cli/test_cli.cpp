@@ -204,6 +204,37 @@ TEST(Cli, SynthThenMatchOnAFreshMachine) {
   EXPECT_NE(m.output.find(": success"), std::string::npos) << m.output;
 }
 
+TEST(Cli, OneThreadOrTwoGiveTheSameAnswerSaidInTheSameOrder) {
+  // With -j 2 both maps are described at once; what is said of each still
+  // comes in order, and the answer is the one of -j 1, bit for bit.
+  TempDir dir;
+  ASSERT_EQ(runTomomap("synth --world room --seed 4 --out " + (dir / "w")).exit_code, 0);
+  const std::string w = dir / "w";
+  const std::string args = "match " + w + "/map_0.pcd " + w + "/map_1.pcd --grid 0.1";
+  nlohmann::json answer[2];
+  for (int threads : {1, 2}) {
+    const std::string json = dir / ("j" + std::to_string(threads) + ".json");
+    const auto r = runTomomap(args + " -j " + std::to_string(threads) + " --json " + json);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const size_t target = r.output.find("target " + w), source = r.output.find("source " + w);
+    ASSERT_NE(target, std::string::npos) << r.output;
+    EXPECT_LT(target, source) << r.output;
+    std::ifstream in(json);
+    answer[threads - 1] = nlohmann::json::parse(in);
+  }
+  EXPECT_EQ(answer[0]["T_target_source"], answer[1]["T_target_source"]);
+  EXPECT_EQ(answer[0]["quality"], answer[1]["quality"]);
+  EXPECT_EQ(answer[0]["target_points"], answer[1]["target_points"]);
+
+  // Both maps bad: the target is named, as when they are read in turn.
+  std::ofstream(dir / "empty.pcd").flush();
+  for (int threads : {1, 2}) {
+    const auto r = runTomomap("match " + (dir / "empty.pcd") + " /nonexistent/b.pcd -j " + std::to_string(threads));
+    expectBadInput(r, "empty.pcd");
+    EXPECT_EQ(r.output.find("/nonexistent/b.pcd"), std::string::npos) << r.output;
+  }
+}
+
 TEST(Cli, SynthRejectsBadOptions) {
   TempDir dir;
   expectBadInput(runTomomap("synth --world forest --out " + (dir / "x")), "--world");
