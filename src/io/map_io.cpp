@@ -123,9 +123,9 @@ Points loadMap(const std::string& path, size_t* nonfinite, std::string* note) {
   return points;
 }
 
-void savePcd(const std::string& path, const Points& points) {
+void savePcd(const std::string& path, const Points& points, PcdData data) {
   std::string error;
-  if (!pclIo().savePcd(path, points, &error)) throw InputError(error);
+  if (!pclIo().savePcd(path, points, data == PcdData::binary_compressed, &error)) throw InputError(error);
 }
 
 Eigen::Matrix4d loadPoseFile(const std::string& path) {

@@ -23,8 +23,13 @@ constexpr uint64_t binaryPcdBytes(size_t points) { return kPcdBytesPerPoint * po
 /// corrupt or empty map, or one with fewer than kMinMapPoints finite points.
 Points loadMap(const std::string& path, size_t* nonfinite = nullptr, std::string* note = nullptr);
 
-/// Writes a binary_compressed PCD (x y z float). Throws InputError on failure.
-void savePcd(const std::string& path, const Points& points);
+/// How savePcd stores the points. Plain binary by default: x, y, z floats do
+/// not compress (the building's map: 22.24 MB plain, 22.42 MB through LZF) and
+/// decompressing costs time on every load (0.016 s of its 0.027).
+enum class PcdData { binary, binary_compressed };
+
+/// Writes a PCD (x y z float). Throws InputError on failure.
+void savePcd(const std::string& path, const Points& points, PcdData data = PcdData::binary);
 
 /// Reads a pose file: 12 numbers, the top 3x4 of a 4x4 map-to-world matrix,
 /// row-major. Throws InputError naming the file and the problem.

@@ -71,12 +71,13 @@ bool load(const std::string& path, bool ply, Points* out, std::string* error) tr
   return false;
 }
 
-bool savePcd(const std::string& path, const Points& points, std::string* error) try {
+bool savePcd(const std::string& path, const Points& points, bool compressed, std::string* error) try {
   silencePcl();
   pcl::PointCloud<pcl::PointXYZ> cloud;
   cloud.reserve(points.size());
   for (const auto& p : points) cloud.push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-  if (cloud.empty() || pcl::io::savePCDFileBinaryCompressed(path, cloud) < 0) {
+  if (cloud.empty() ||
+      (compressed ? pcl::io::savePCDFileBinaryCompressed(path, cloud) : pcl::io::savePCDFileBinary(path, cloud)) < 0) {
     *error = path + ": cannot write map";
     return false;
   }

@@ -16,12 +16,12 @@ namespace tomomap {
 struct PclIo {
   /// Reads x, y, z of a PCD (`ply` false) or PLY file into *out.
   bool (*load)(const std::string& path, bool ply, Points* out, std::string* error);
-  /// Writes a binary_compressed PCD (x y z float).
-  bool (*savePcd)(const std::string& path, const Points& points, std::string* error);
+  /// Writes a binary PCD (x y z float), LZF-compressed (binary_compressed) if `compressed`.
+  bool (*savePcd)(const std::string& path, const Points& points, bool compressed, std::string* error);
 };
 
 /// Bumped whenever PclIo changes, so that a binary never calls a stale module.
-constexpr unsigned kPclIoVersion = 1;
+constexpr unsigned kPclIoVersion = 2;
 /// The module's file, looked up in the folders the program's RUNPATH names (CMakeLists.txt).
 constexpr const char* kPclIoModule = "tomomap_pcl_io.so";
 /// Its entry point: the functions, or nullptr if `version` is not its own.

@@ -7,6 +7,7 @@
 #include "support.hpp"
 
 using namespace tomomap;
+using tomomap::test::readText;
 using tomomap::test::TempDir;
 
 static Points grid(int n) {
@@ -34,13 +35,17 @@ static std::string errorOf(F f) {
   return "";
 }
 
-TEST(MapIo, RoundTripsBinaryCompressedPcd) {
+TEST(MapIo, RoundTripsBinaryAndBinaryCompressedPcd) {
   TempDir dir;
   const Points p = grid(500);
-  savePcd(dir / "m.pcd", p);
-  const Points q = loadMap(dir / "m.pcd");
-  ASSERT_EQ(q.size(), p.size());
-  EXPECT_EQ(q[123], p[123]);
+  for (const auto& [data, name] :
+       {std::pair{PcdData::binary, "DATA binary\n"}, {PcdData::binary_compressed, "DATA binary_compressed\n"}}) {
+    savePcd(dir / "m.pcd", p, data);
+    EXPECT_NE(readText(dir / "m.pcd").find(name), std::string::npos) << name;
+    const Points q = loadMap(dir / "m.pcd");
+    ASSERT_EQ(q.size(), p.size());
+    EXPECT_EQ(q[123], p[123]);
+  }
 }
 
 // Binary PCDs are read by the integrity check's own pass (pcd_check.hpp):
@@ -146,7 +151,7 @@ TEST(MapIo, AMapWithTooFewFinitePointsIsRefused) {
 
 TEST(MapIo, TruncatedAndCorruptPcdAreRejected) {
   TempDir dir;
-  savePcd(dir / "good.pcd", grid(5000));
+  savePcd(dir / "good.pcd", grid(5000), PcdData::binary_compressed);  // a garbled payload shows in its LZF
   std::ifstream in(dir / "good.pcd", std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), {});
   std::ofstream(dir / "cut.pcd", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
