@@ -8,6 +8,11 @@
 
 namespace tomomap {
 
+/// How many standard errors a tilt estimate must clear: its error, to be
+/// levelled by (within the tolerance); its excess over the tolerance, to be
+/// refused as tilted.
+constexpr double kTiltSigmas = 3.0;
+
 struct Tilt {
   bool measured = false;              ///< enough flat surfaces to tell; if not, the rest means nothing
   double angle = 0;                   ///< between the map's z axis and `up` [rad]
@@ -21,8 +26,11 @@ struct Tilt {
   size_t floor_patches = 0;  ///< flat patches facing up (floors, ceilings, ground)
   size_t wall_patches = 0;   ///< flat patches facing sideways (walls)
 
-  /// Whether the estimate is good to level by: within `tolerance` at three standard errors.
-  bool levelable(double tolerance) const { return measured && 3.0 * uncertainty <= tolerance; }
+  /// Whether the estimate is good to level by: within `tolerance` at kTiltSigmas standard errors.
+  bool levelable(double tolerance) const { return measured && kTiltSigmas * uncertainty <= tolerance; }
+  /// Whether the map may lie within `tolerance`: its tilt is not beyond it by
+  /// kTiltSigmas standard errors (or not measured).
+  bool mayBeWithin(double tolerance) const { return !measured || angle - kTiltSigmas * uncertainty <= tolerance; }
 
   /// The rotation that makes the map level: it turns `up` onto z (the
   /// smallest such rotation: no yaw is added).

@@ -107,6 +107,28 @@ TEST(Gravity, AFewScatteredPointsAreNotMeasured) {
   EXPECT_FALSE(estimateTilt(p, 0.05).measured);
 }
 
+TEST(Matcher, ATiltTooUncertainToLevelIsRefusedOnlyWhenItIsSurelyBeyondTheTolerance) {
+  // Figures of real LiDAR crops (a thinned nuScenes crop whose ground lies
+  // 1.6 deg off read 4.6 +- 1.1 deg) and of a surely tilted map.
+  const auto map = [](double deg, double sigma_deg) {
+    MapFeatures f;
+    f.tilt.measured = true;
+    f.tilt.angle = radians(deg);
+    f.tilt.uncertainty = radians(sigma_deg);
+    return f;
+  };
+  const MatchParams params;  // matched as it is up to 3 deg, levelled where measured to 1 deg
+  EXPECT_FALSE(tiltRefusal(map(4.6, 1.1), "target", params)) << "may lie within 3 deg: matched as it is";
+  EXPECT_FALSE(tiltRefusal(map(5.9, 1.0), "target", params));
+  const auto surely = tiltRefusal(map(7.5, 1.4), "source", params);
+  ASSERT_TRUE(surely) << "beyond 3 deg by three standard errors, too uncertain to level";
+  EXPECT_NE(surely->find("not measured well enough to level"), std::string::npos) << *surely;
+  EXPECT_TRUE(tiltRefusal(map(40, 20), "source", params)) << "beyond what is ever levelled";
+  MatchParams no_level;
+  no_level.level = false;
+  EXPECT_TRUE(tiltRefusal(map(5.0, 0.1), "source", no_level)) << "surely tilted, levelling off";
+}
+
 TEST(Matcher, ATiltedMapIsLevelledOrWithoutLevellingRefused) {
   REQUIRE_DEMO_ROOM();
   const auto demo = test::loadDemoPair();
