@@ -42,23 +42,33 @@ std::string mapSource(const Config& config) {
 
 namespace {
 
-/// Describes and encodes the map `load` reads into `own`'s counts.
-OwnMap describeLoaded(const Config& config, OwnMap own, const std::function<Points(OwnMap&)>& load) {
+/// Describes and encodes the map `load` reads into `own`'s counts, on
+/// `before`'s cubes, raster and slices where they still hold.
+OwnMap describeLoaded(const Config& config, OwnMap own, const std::function<Points(OwnMap&)>& load,
+                      const Described& before) {
   const auto t0 = Clock::now();
+  const FeatureParams& fp = config.match.features;
+  const bool alike = before.features && before.offer && before.features->grid == config.match.grid && [&] {
+    const FeatureParams then = transport::featureParamsOf(before.offer->announcement);
+    return then.max_features == fp.max_features && then.fast_threshold == fp.fast_threshold && then.pad == fp.pad;
+  }();
   auto features = [&] {
     const Points map = load(own);  // dropped once described
     const auto loaded = Clock::now();
-    auto described = std::make_shared<MapFeatures>(describeMap(map, config.match, &own.stages, &own.cells));
+    auto described = std::make_shared<MapFeatures>(
+        describeMap(map, config.match, &own.stages, &own.cells, alike ? before.features.get() : nullptr));
     own.stages.load = seconds(loaded - t0);
     return described;
   }();
   // Peers would match slanted slices: offered nowhere, refused here.
   if (const auto why = tiltRefusal(*features, "own", config.match)) throw InputError(mapSource(config) + ": " + *why);
   const auto encoding = Clock::now();
+  std::optional<transport::EarlierOffer> earlier;
+  if (alike) earlier.emplace(transport::EarlierOffer{*before.features, *before.offer});
   own.offer = transport::makeOffer(
       config.agent(), *features, config.match.features, binaryPcdBytes(own.cells),
       transport::maxSampleBytes(config.transport.bandwidth_kbps, config.transport.security.enabled()),
-      config.match.threads);
+      config.match.threads, earlier ? &*earlier : nullptr);
   own.features = std::move(features);
   own.encoding = seconds(Clock::now() - encoding);
   own.seconds = seconds(Clock::now() - t0);
@@ -67,23 +77,32 @@ OwnMap describeLoaded(const Config& config, OwnMap own, const std::function<Poin
 
 }  // namespace
 
-OwnMap describeOwnMap(const Config& config) {
-  return describeLoaded(config, {}, [&](OwnMap& own) { return loadMap(config.map, &own.nonfinite, &own.note); });
+OwnMap describeOwnMap(const Config& config, const Described& before) {
+  return describeLoaded(
+      config, {}, [&](OwnMap& own) { return loadMap(config.map, &own.nonfinite, &own.note); }, before);
 }
 
-OwnMap describeOwnMap(const Config& config, const transport::CloudMessage& cloud) {
+Described Agent::described() const {
+  if (!offering()) return {};
+  return {own_features_, std::make_shared<const transport::MapOffer>(sender_.offer())};
+}
+
+OwnMap describeOwnMap(const Config& config, const transport::CloudMessage& cloud, const Described& before) {
   OwnMap own;
   own.frame_id = cloud.frame_id;
-  return describeLoaded(config, std::move(own), [&](OwnMap& o) {
-    Points points;
-    try {
-      points = pointsFromCloud2(cloud.layout, cloud.data.data(), cloud.data.size(), &o.nonfinite);
-    } catch (const InputError& e) {
-      throw InputError(mapSource(config) + ": " + e.what());
-    }
-    validateMap(points, mapSource(config));  // as a map file is (loadMap): an empty or tiny map is refused
-    return points;
-  });
+  return describeLoaded(
+      config, std::move(own),
+      [&](OwnMap& o) {
+        Points points;
+        try {
+          points = pointsFromCloud2(cloud.layout, cloud.data.data(), cloud.data.size(), &o.nonfinite);
+        } catch (const InputError& e) {
+          throw InputError(mapSource(config) + ": " + e.what());
+        }
+        validateMap(points, mapSource(config));  // as a map file is (loadMap): an empty or tiny map is refused
+        return points;
+      },
+      before);
 }
 
 void Agent::installOwnMap(OwnMap own) {
@@ -106,6 +125,13 @@ void Agent::installOwnMap(OwnMap own) {
   for (const auto& [k, samples] : offer.samples)
     as_cells += samples.front().encoding() == wire::SliceEncoding::OCCUPANCY;
   const auto& a = offer.announcement;
+  // An update on the previous version's raster: ORB and encoding only where it changed.
+  int occupied = 0;
+  for (const auto& c : own_features_->occupancy.cells) occupied += !c.empty();
+  const std::string anew = update ? "; ORB on " + std::to_string(occupied - own_features_->kept_slices) + " of " +
+                                        std::to_string(occupied) + " slices, " + std::to_string(offer.encoded_slices) +
+                                        " of " + std::to_string(a.slices().size()) + " encoded, the rest unchanged"
+                                  : "";
   log_.info(
       std::string(update ? "map updated: " : "map ") + source +
       (own.frame_id.empty() ? "" : " (frame " + own.frame_id + ")") + ": " + std::to_string(own.cells) +
@@ -115,10 +141,9 @@ void Agent::installOwnMap(OwnMap own) {
       (update ? " (was " + versionText(before) + ")" : "") + "; payload " + std::to_string(offer.payload_bytes) +
       " bytes = " + fixed(100.0 * static_cast<double>(offer.payload_bytes) / static_cast<double>(a.raw_bytes()), 1) +
       " % of the voxel-filtered map's binary PCD (" + std::to_string(a.raw_bytes()) + " bytes); " +
-      tiltText(*own_features_) + "; described in " + fixed(own.seconds, 2) + " s (read " +
-      fixed(own.stages.load, 2) + ", voxel filter " + fixed(own.stages.voxel, 2) + ", slices " +
-      fixed(own.stages.slicing, 2) + ", ORB " + fixed(own.stages.features, 2) + ", encoding " + fixed(own.encoding, 2) +
-      ")");
+      tiltText(*own_features_) + "; described in " + fixed(own.seconds, 2) + " s (read " + fixed(own.stages.load, 2) +
+      ", voxel filter " + fixed(own.stages.voxel, 2) + ", slices " + fixed(own.stages.slicing, 2) + ", ORB " +
+      fixed(own.stages.features, 2) + ", encoding " + fixed(own.encoding, 2) + anew + ")");
   if (bus_) {
     bus_->publish(a);
     reannounce_ = false;  // every peer that asked gets this one

@@ -51,11 +51,18 @@ struct OwnMap {
 /// Where the config says the map comes from: its file, or "ROS 2 topic X".
 std::string mapSource(const Config& config);
 
+/// This agent's map as it was last described and offered: what an update of
+/// it keeps (slices the change did not touch are not described or encoded again).
+struct Described {
+  std::shared_ptr<const MapFeatures> features;
+  std::shared_ptr<const transport::MapOffer> offer;
+};
+
 /// Loads, describes and encodes the map the config names (its file). Throws
 /// InputError for an unreadable map. Pure work: safe to run on any thread.
-OwnMap describeOwnMap(const Config& config);
+OwnMap describeOwnMap(const Config& config, const Described& before = {});
 /// The same for a map that arrived on the [ros2] map_topic.
-OwnMap describeOwnMap(const Config& config, const transport::CloudMessage& cloud);
+OwnMap describeOwnMap(const Config& config, const transport::CloudMessage& cloud, const Described& before = {});
 
 /// The claim timings the config sets.
 inline BoardTimings boardTimings(const Config& c) {
@@ -159,6 +166,8 @@ class Agent {
   std::shared_ptr<const MapFeatures> own_features_;  ///< null until the map file first exists and is usable
   /// Whether this agent offers a map yet (at boot the file may not exist).
   bool offering() const { return own_features_ != nullptr; }
+  /// What the map on offer lends its next version.
+  Described described() const;
   /// What the status says while nothing is offered.
   std::string waitingText() const;
   MapSender sender_;

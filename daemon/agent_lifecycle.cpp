@@ -81,12 +81,14 @@ void Agent::followMapFile() {
     if (!cloud_) return;
     log_.info("map message on " + config_.ros2.map_topic + " (" + std::to_string(cloud_->data.size()) +
               " bytes): describing it");
-    describing_ = std::async(std::launch::async,
-                             [config = config_, cloud = std::move(cloud_)] { return describeOwnMap(config, *cloud); });
+    describing_ = std::async(std::launch::async, [config = config_, cloud = std::move(cloud_), before = described()] {
+      return describeOwnMap(config, *cloud, before);
+    });
     return;
   }
   log_.info("map file changed: describing it again");
-  describing_ = std::async(std::launch::async, [config = config_] { return describeOwnMap(config); });
+  describing_ = std::async(std::launch::async,
+                           [config = config_, before = described()] { return describeOwnMap(config, before); });
 }
 
 void Agent::reload() {

@@ -1,5 +1,6 @@
 #include "features.hpp"
 
+#include <algorithm>
 #include <utility>
 
 #include "threads.hpp"
@@ -24,16 +25,27 @@ cv::Ptr<cv::ORB> sliceDetector(const FeatureParams& params) {
   return cv::ORB::create(params.max_features, 1.2f, 1, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31, params.fast_threshold);
 }
 
-MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params, int threads) {
+MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params, int threads, const MapFeatures* previous) {
   MapFeatures out;
   out.grid = stack.grid.cell;
   out.z_min = stack.grid.z_min;
   out.slice_count = stack.size();
   std::vector<SliceFeatures> per_slice(static_cast<size_t>(stack.size()));
+  // The slices an earlier description of this raster holds unchanged.
+  std::vector<char> kept(per_slice.size(), 0);
+  if (previous && !previous->leveled && previous->occupancy.grid == stack.grid) {
+    const auto& before = previous->occupancy.cells;
+    for (size_t k = 0; k < kept.size() && k < before.size(); ++k)
+      kept[k] = !stack.cells[k].empty() && before[k] == stack.cells[k];
+    for (const auto& s : previous->slices)
+      if (static_cast<size_t>(s.index) < kept.size() && kept[static_cast<size_t>(s.index)])
+        per_slice[static_cast<size_t>(s.index)] = s;
+    out.kept_slices = static_cast<int>(std::count(kept.begin(), kept.end(), 1));
+  }
 
 #pragma omp parallel for schedule(dynamic) num_threads(resolvedThreads(threads))
   for (int k = 0; k < stack.size(); ++k) {
-    if (stack.cells[static_cast<size_t>(k)].empty()) continue;
+    if (stack.cells[static_cast<size_t>(k)].empty() || kept[static_cast<size_t>(k)]) continue;
     // Only the occupied part of the raster, padded: the same keypoints and
     // descriptors as on the whole image (every one sits on an occupied cell,
     // and the pad holds its patch and blur): on a street, whose slices are

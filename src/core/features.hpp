@@ -34,6 +34,10 @@ struct MapFeatures {
   /// (turned by tilt.leveling()) first. Known where the map was described, not sent.
   Tilt tilt;
   bool leveled = false;
+  /// Where the voxel filter's cubes start (voxelFilter's corner), and how many
+  /// slices kept an earlier description's features (extractFeatures). Local, not sent.
+  Eigen::Vector3f voxel_corner{NAN, NAN, NAN};
+  int kept_slices = 0;
 
   double sliceHeight(int k) const { return z_min + k * grid; }
   size_t featureCount() const;
@@ -51,7 +55,10 @@ cv::Ptr<cv::ORB> sliceDetector(const FeatureParams& params);
 
 /// Detects ORB on every non-empty slice, in parallel over slices on `threads`
 /// threads (0: every core). The stack moves into the result's `occupancy`
-/// (pass a copy to keep your own).
-MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params = {}, int threads = 0);
+/// (pass a copy to keep your own). With `previous` (described with the same
+/// `params`), a slice whose raster and cells are its slice's there takes that
+/// slice's features instead: ORB would find the very same.
+MapFeatures extractFeatures(SliceStack stack, const FeatureParams& params = {}, int threads = 0,
+                            const MapFeatures* previous = nullptr);
 
 }  // namespace tomomap

@@ -100,8 +100,12 @@ MatchResult matchMaps(const Points& target, const Points& source, const MatchPar
                       const Progress& progress = {});
 
 /// Voxel filter, slicing and features of one map, with the time each took and
-/// (if asked) how many points the voxel filter kept.
+/// (if asked) how many points the voxel filter kept. With `previous` (an
+/// earlier version of this map, described with the same params), the map is
+/// filtered on its cubes and sliced on its raster while it stays within them,
+/// and the slices the change did not touch keep their features (kept_slices):
+/// the same description as from scratch on that raster, ORB only where it changed.
 MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings = nullptr,
-                        size_t* filtered_points = nullptr);
+                        size_t* filtered_points = nullptr, const MapFeatures* previous = nullptr);
 
 }  // namespace tomomap

@@ -32,7 +32,7 @@ cv::Rect SliceStack::occupiedArea(int k) const {
   return {static_cast<int>(u0), static_cast<int>(v0), static_cast<int>(u1 - u0 + 1), static_cast<int>(v1 - v0 + 1)};
 }
 
-SliceStack makeSlices(const Points& points, double cell, int threads) {
+SliceStack makeSlices(const Points& points, double cell, int threads, const SliceStack* keep) {
   if (!(cell > 0.0)) throw InputError("grid size must be positive");
   SliceStack stack;
   if (points.empty()) return stack;
@@ -58,19 +58,29 @@ SliceStack makeSlices(const Points& points, double cell, int threads) {
   }
   g.width = static_cast<int>(w);
   g.height = static_cast<int>(h);
+  size_t n_slices = static_cast<size_t>(n);
+  if (keep && keep->grid.cell == cell && keep->size() > 0) {
+    const SliceGrid& k = keep->grid;
+    const bool within = lo.x() >= k.x_min && lo.y() >= k.y_min && k.sliceIndex(lo.z()) >= 0 &&
+                        (hi.x() - k.x_min) / cell < k.width && (hi.y() - k.y_min) / cell < k.height;
+    if (within) {
+      g = k;
+      n_slices = static_cast<size_t>(std::max(k.sliceIndex(hi.z()) + 1, keep->size()));
+    }
+  }
 
   // Each point's cell, grouped by slice (a counting sort), then each slice's
   // cells marked in a bitmap of the raster and read back in order: sorted and
   // unique in two linear passes, where sorting each slice's cells took most of
   // the slicing time on a 2 M-point building.
-  const auto slices = static_cast<size_t>(n);
+  const auto slices = n_slices;
   // A point's slice and cell, or nothing for a point left out as stray. Worked
   // out again in each pass rather than kept in two arrays the size of the map,
   // whose memory traffic made slicing twice as slow (0.11 against 0.055 s on a
   // 2.3 M-voxel building).
   const auto place = [&](const Eigen::Vector3f& p) -> std::optional<std::pair<size_t, uint32_t>> {
     if (bounds.outside > 0 && !bounds.contains(p)) return std::nullopt;
-    const int k = std::clamp(g.sliceIndex(p.z()), 0, static_cast<int>(n) - 1);
+    const int k = std::clamp(g.sliceIndex(p.z()), 0, static_cast<int>(slices) - 1);
     const int u = std::min(static_cast<int>((p.x() - g.x_min) / cell), g.width - 1);
     const int v = std::min(static_cast<int>((p.y() - g.y_min) / cell), g.height - 1);
     return std::pair{static_cast<size_t>(k), static_cast<uint32_t>(v * g.width + u)};

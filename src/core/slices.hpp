@@ -26,6 +26,10 @@ struct SliceGrid {
     const auto w = static_cast<uint32_t>(width);
     return toMetres(static_cast<float>(index % w), static_cast<float>(index / w)).cast<double>();
   }
+  bool operator==(const SliceGrid& o) const {
+    return cell == o.cell && x_min == o.x_min && y_min == o.y_min && z_min == o.z_min && width == o.width &&
+           height == o.height;
+  }
   /// The inverse: (sub)pixel position of map-frame x, y [m]; centres are integers.
   Eigen::Vector2d toPixel(double x, double y) const { return {(x - x_min) / cell - 0.5, (y - y_min) / cell - 0.5}; }
 };
@@ -59,7 +63,10 @@ constexpr int kMaxImageSide = 16384;
 /// occupied cells than (width + height) / 2 are kept empty (too sparse for ORB);
 /// empty slices at the bottom and top are trimmed. Throws InputError if the
 /// raster would exceed kMaxImageSide. Uses `threads` threads (0: every core).
-SliceStack makeSlices(const Points& points, double cell, int threads = 0);
+/// With `keep` (an earlier version of the map, sliced at `cell`), its raster
+/// and slice heights are kept while the points stay within them: a slice the
+/// change did not touch comes out as it was.
+SliceStack makeSlices(const Points& points, double cell, int threads = 0, const SliceStack* keep = nullptr);
 
 /// The same occupancy at twice the cell: each 2 x 2 block of cells and each
 /// two slices become one (a cell occupied where any of its eight was). Pooled

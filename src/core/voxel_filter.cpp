@@ -78,11 +78,15 @@ void appendBinnedInPlace(const Points& in, const uint32_t* first, const uint32_t
 
 }  // namespace
 
-Points voxelFilter(const Points& in, double leaf) {
+Points voxelFilter(const Points& in, double leaf, Eigen::Vector3f* corner) {
   if (in.empty()) return {};
   if (!(leaf > 0.0)) throw InputError("voxel leaf size must be positive");
   Eigen::Vector3f lo = in.front(), hi = in.front();
   for (const auto& p : in) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  if (corner) {
+    if (corner->allFinite() && (corner->array() <= lo.array()).all()) lo = *corner;
+    *corner = lo;
+  }
 
   // Cell indices per axis, capped at 2^21 (100 km at 0.05 m) so that a packed
   // cell fits 64 bits whatever the extent; packed as (z * ny + y) * nx + x, so

@@ -76,7 +76,7 @@ std::vector<wire::SliceFeatures> cutSlice(const std::string& agent, const SliceF
 }  // namespace
 
 MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const FeatureParams& params, uint64_t raw_bytes,
-                   size_t max_sample_bytes, int threads) {
+                   size_t max_sample_bytes, int threads, const EarlierOffer* earlier) {
   const SliceGrid& g = f.occupancy.grid;
   const size_t header = sampleHeaderBytes(agent);
   const size_t room = max_sample_bytes > header + kFeatureBytes ? max_sample_bytes - header : kFeatureBytes;
@@ -111,13 +111,38 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const Feature
   // so that the receiver can search it too (it rebuilds the same features
   // from the cells); such maps are a few kilobytes either way.
   const bool cells_first = denseSearchable(f.occupancy);
+  offer.cells_first = cells_first;
+  // The earlier version's samples of a slice whose cells and features are
+  // unchanged are this one's: cut alike from the same raster, settings and budget.
+  const bool alike = earlier && earlier->offer.sample_bytes == max_sample_bytes &&
+                     earlier->offer.cells_first == cells_first && earlier->features.occupancy.grid == g &&
+                     earlier->offer.announcement.agent() == agent &&
+                     featureParamsOf(earlier->offer.announcement).max_features == params.max_features &&
+                     featureParamsOf(earlier->offer.announcement).fast_threshold == params.fast_threshold &&
+                     featureParamsOf(earlier->offer.announcement).pad == params.pad;
+  std::map<int, const SliceFeatures*> earlier_slices;
+  if (alike)
+    for (const auto& s : earlier->features.slices) earlier_slices[s.index] = &s;
+  const auto unchanged = [&](const SliceFeatures& s) {
+    const auto was = earlier_slices.find(s.index);
+    if (was == earlier_slices.end() || !earlier->offer.samples.count(s.index)) return false;
+    const auto k = static_cast<size_t>(s.index);
+    return earlier->features.occupancy.cells.size() > k &&
+           earlier->features.occupancy.cells[k] == f.occupancy.cells.at(k) && was->second->keypoints == s.keypoints &&
+           cv::norm(was->second->descriptors, s.descriptors, cv::NORM_HAMMING) == 0.0;
+  };
   // Deflating each slice twice (slice_encoding.cpp) is most of the work: in
   // parallel over slices, then put together in order.
   std::vector<std::vector<wire::SliceFeatures>> cut(order.size());
+  std::vector<char> taken(order.size(), 0);
 #pragma omp parallel for schedule(dynamic) num_threads(resolvedThreads(threads))
-  for (size_t i = 0; i < order.size(); ++i)
-    cut[i] = cutSlice(agent, *order[i], f.occupancy.cells.at(static_cast<size_t>(order[i]->index)), g,
-                      features_per_part, bytes_per_part, cells_first);
+  for (size_t i = 0; i < order.size(); ++i) {
+    taken[i] = unchanged(*order[i]);
+    cut[i] = taken[i] ? earlier->offer.samples.at(order[i]->index)
+                      : cutSlice(agent, *order[i], f.occupancy.cells.at(static_cast<size_t>(order[i]->index)), g,
+                                 features_per_part, bytes_per_part, cells_first);
+  }
+  offer.encoded_slices = static_cast<size_t>(std::count(taken.begin(), taken.end(), 0));
   for (size_t i = 0; i < order.size(); ++i) {
     const SliceFeatures* s = order[i];
     auto& samples = cut[i];

@@ -21,7 +21,15 @@ struct MapOffer {
   /// each slice's parts.
   std::vector<wire::SliceFeatures> bundles;
   std::map<int, std::vector<size_t>> bundles_of;
-  size_t sample_bytes = 0;  ///< the most a sample may take, serialized
+  size_t sample_bytes = 0;    ///< the most a sample may take, serialized
+  bool cells_first = false;   ///< every slice as occupancy (a map small enough for the dense search)
+  size_t encoded_slices = 0;  ///< slices cut anew; the rest were taken from an earlier version
+};
+
+/// An earlier version of the same map, described and offered.
+struct EarlierOffer {
+  const MapFeatures& features;
+  const MapOffer& offer;
 };
 
 /// Fills `offer.bundles` and `offer.bundles_of` from its samples. With the
@@ -43,9 +51,11 @@ std::set<int> unchangedSlices(const wire::MapAnnouncement& now, const wire::MapA
 /// every slice as occupancy when the map is small enough for the dense search.
 /// `raw_bytes` is the binary PCD size of the voxel-filtered map, announced for
 /// the record. Most informative slices (most features) first. Encodes on
-/// `threads` threads (0: every core).
+/// `threads` threads (0: every core). With `earlier`, a slice whose cells and
+/// features are its slice's there, on the same raster, settings and budget,
+/// takes its samples instead of being cut again: the same bytes.
 MapOffer makeOffer(const std::string& agent, const MapFeatures& features, const FeatureParams& params,
-                   uint64_t raw_bytes, size_t max_sample_bytes, int threads = 0);
+                   uint64_t raw_bytes, size_t max_sample_bytes, int threads = 0, const EarlierOffer* earlier = nullptr);
 
 /// Hash of a map's raster, feature settings, slices and chunking: equal maps
 /// described alike and cut for equal budgets have equal versions.

@@ -271,6 +271,18 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
   EXPECT_LT(transfers[1]["bytes"].get<size_t>(), transfers[0]["bytes"].get<size_t>()) << transfers.dump(2);
   const size_t sent_total = fleet.readJson("bravo", "status.json")["sent"]["bytes"];
   EXPECT_LT(sent_total - sent_first, sent_first) << "the resend is smaller than the first transfer";
+  // And bravo described only what the cabinet changed: ORB and encoding on those slices alone.
+  const std::string log = fleet.log("bravo");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(log, m, std::regex("ORB on ([0-9]+) of ([0-9]+) slices, ([0-9]+) of ([0-9]+) encoded")))
+      << log;
+  const int orb = std::stoi(m[1]), occupied = std::stoi(m[2]), encoded = std::stoi(m[3]), offered = std::stoi(m[4]);
+  EXPECT_GT(orb, 0);
+  EXPECT_LT(orb, occupied);
+  EXPECT_LT(encoded, offered);
+  EXPECT_GE(encoded, transfers[1]["slices"].get<int>() - transfers[1]["slices_reused"].get<int>())
+      << "every slice alpha had to fetch again was encoded again";
+  std::printf("bravo's update: ORB on %d of %d slices, %d of %d encoded\n", orb, occupied, encoded, offered);
   std::printf(
       "first transfer %zu B (%d slices); after the update %zu B (%d of %d slices reused); bravo sent %zu then "
       "%zu B\n",

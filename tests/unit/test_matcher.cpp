@@ -4,6 +4,8 @@
 
 #include "core/matcher.hpp"
 #include "support.hpp"
+#include "synth/scene.hpp"
+#include "synth/synth.hpp"
 
 using namespace tomomap;
 
@@ -114,4 +116,59 @@ TEST(Matcher, ATieBetweenTwoHeightsIsNoReliableMatch) {
   EXPECT_FALSE(r.reliable) << "support " << r.support << ", runner-up " << r.runner_up_support;
   EXPECT_NE(r.reason.find("ambiguous"), std::string::npos) << r.reason;
   EXPECT_GT(std::abs(r.runner_up_offset - r.height_offset), 60) << "4 m apart at g 0.05";
+}
+
+namespace {
+
+/// Every slice's features, as equal or not.
+void expectSameFeatures(const MapFeatures& a, const MapFeatures& b) {
+  ASSERT_EQ(a.slices.size(), b.slices.size());
+  for (size_t i = 0; i < a.slices.size(); ++i) {
+    EXPECT_EQ(a.slices[i].index, b.slices[i].index);
+    EXPECT_EQ(a.slices[i].keypoints, b.slices[i].keypoints) << "slice " << a.slices[i].index;
+    EXPECT_EQ(cv::norm(a.slices[i].descriptors, b.slices[i].descriptors, cv::NORM_HAMMING), 0.0);
+  }
+}
+
+int describedSlices(const MapFeatures& f) {
+  int n = 0;
+  for (const auto& c : f.occupancy.cells) n += !c.empty();
+  return n;
+}
+
+}  // namespace
+
+TEST(Matcher, AnUpdateDescribedOnItsEarlierVersionRunsOrbOnlyWhereItChanged) {
+  synth::SceneParams sp;
+  sp.scale = 0.5;
+  const Points before_points = synth::scanScene(synth::makeScene(sp), synth::noiseLevel("low"), 1).front().points;
+  MatchParams p;
+  p.grid = 0.1;
+  const MapFeatures before = describeMap(before_points, p);
+
+  // The same map again: every slice kept, nothing described anew.
+  const MapFeatures same = describeMap(before_points, p, nullptr, nullptr, &before);
+  EXPECT_EQ(same.kept_slices, describedSlices(before));
+  expectSameFeatures(same, before);
+
+  // A cabinet inside the map: ORB runs on the slices it touched alone, and
+  // the description is the one made from scratch.
+  const Points updated = test::withCabinet(before_points);
+  const MapFeatures fresh = describeMap(updated, p), kept = describeMap(updated, p, nullptr, nullptr, &before);
+  ASSERT_TRUE(kept.occupancy.grid == fresh.occupancy.grid);
+  EXPECT_GT(kept.kept_slices, 0);
+  EXPECT_LT(kept.kept_slices, describedSlices(kept));
+  EXPECT_EQ(kept.occupancy.cells, fresh.occupancy.cells);
+  expectSameFeatures(kept, fresh);
+
+  // A map that grew beyond its raster (the robot mapped the next building
+  // along) is described from scratch.
+  Points grown = before_points;
+  const SliceGrid& g = before.occupancy.grid;
+  const auto along = static_cast<float>(g.width * g.cell);
+  for (const auto& q : before_points) grown.emplace_back(q.x() + along, q.y(), q.z());
+  const MapFeatures grown_kept = describeMap(grown, p, nullptr, nullptr, &before);
+  EXPECT_FALSE(grown_kept.occupancy.grid == g);
+  EXPECT_EQ(grown_kept.kept_slices, 0);
+  expectSameFeatures(grown_kept, describeMap(grown, p));
 }
