@@ -47,11 +47,8 @@ namespace {
 OwnMap describeLoaded(const Config& config, OwnMap own, const std::function<Points(OwnMap&)>& load,
                       const Described& before) {
   const auto t0 = Clock::now();
-  const FeatureParams& fp = config.match.features;
-  const bool alike = before.features && before.offer && before.features->grid == config.match.grid && [&] {
-    const FeatureParams then = transport::featureParamsOf(before.offer->announcement);
-    return then.max_features == fp.max_features && then.fast_threshold == fp.fast_threshold && then.pad == fp.pad;
-  }();
+  const bool alike = before.features && before.offer && before.features->grid == config.match.grid &&
+                     transport::featureParamsOf(before.offer->announcement) == config.match.features;
   auto features = [&] {
     const Points map = load(own);  // dropped once described
     const auto loaded = Clock::now();
@@ -126,8 +123,7 @@ void Agent::installOwnMap(OwnMap own) {
     as_cells += samples.front().encoding() == wire::SliceEncoding::OCCUPANCY;
   const auto& a = offer.announcement;
   // An update on the previous version's raster: ORB and encoding only where it changed.
-  int occupied = 0;
-  for (const auto& c : own_features_->occupancy.cells) occupied += !c.empty();
+  const int occupied = own_features_->occupancy.occupiedSlices();
   const std::string anew = update ? "; ORB on " + std::to_string(occupied - own_features_->kept_slices) + " of " +
                                         std::to_string(occupied) + " slices, " + std::to_string(offer.encoded_slices) +
                                         " of " + std::to_string(a.slices().size()) + " encoded, the rest unchanged"

@@ -13,6 +13,9 @@ struct FeatureParams {
   int fast_threshold = 20;  ///< FAST corner threshold on the 0/255 images
   int pad = 32;  ///< empty border around each slice image [pixels]: >= ORB's edge threshold (31) and its patch and blur
                  ///< reach (about 25)
+  bool operator==(const FeatureParams& o) const {
+    return max_features == o.max_features && fast_threshold == o.fast_threshold && pad == o.pad;
+  }
 };
 
 struct SliceFeatures {

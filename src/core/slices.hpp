@@ -1,5 +1,6 @@
 #pragma once
 // Tomographic slicing: a map becomes a stack of horizontal binary occupancy images.
+#include <algorithm>
 #include <cstdint>
 #include <opencv2/core.hpp>
 
@@ -44,6 +45,10 @@ struct SliceStack {
   bool partial = false;
 
   int size() const { return static_cast<int>(cells.size()); }
+  /// Slices with cells (the others are too sparse to describe).
+  int occupiedSlices() const {
+    return static_cast<int>(std::count_if(cells.begin(), cells.end(), [](const auto& c) { return !c.empty(); }));
+  }
   /// Renders slice k as a CV_8U image, 255 = occupied, with `pad` empty pixels
   /// around it (ORB finds no corners within its border distance).
   cv::Mat image(int k, int pad = 0) const { return image(k, cv::Rect(0, 0, grid.width, grid.height), pad); }

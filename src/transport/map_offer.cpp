@@ -117,9 +117,7 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const Feature
   const bool alike = earlier && earlier->offer.sample_bytes == max_sample_bytes &&
                      earlier->offer.cells_first == cells_first && earlier->features.occupancy.grid == g &&
                      earlier->offer.announcement.agent() == agent &&
-                     featureParamsOf(earlier->offer.announcement).max_features == params.max_features &&
-                     featureParamsOf(earlier->offer.announcement).fast_threshold == params.fast_threshold &&
-                     featureParamsOf(earlier->offer.announcement).pad == params.pad;
+                     featureParamsOf(earlier->offer.announcement) == params;
   std::map<int, const SliceFeatures*> earlier_slices;
   if (alike)
     for (const auto& s : earlier->features.slices) earlier_slices[s.index] = &s;

@@ -36,8 +36,7 @@ int main(int argc, char** argv) {
     whole.push_back(secondsOf([&] { describeMap(updated, p); }));
     changed.push_back(secondsOf([&] { redescribed = describeMap(updated, p, nullptr, nullptr, &before); }));
   }
-  int occupied = 0;
-  for (const auto& c : redescribed.occupancy.cells) occupied += !c.empty();
+  const int occupied = redescribed.occupancy.occupiedSlices();
   std::printf(
       "describe after a cabinet, g %.2f, median of %d: from scratch %.3f s, on the previous version %.3f s (ORB on "
       "%d of %d slices)\n",
