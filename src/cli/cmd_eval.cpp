@@ -248,6 +248,7 @@ int runEval(const EvalOptions& o) {
     for (int64_t seed : c.seeds) {
       synth::ScanPairParams params;
       params.seed = static_cast<uint64_t>(seed);
+      params.move_xy = c.move;
       const std::string folder = c.name + "-" + std::to_string(seed) + "-g" + shortNumber(c.grid);
       std::cerr << "cutting " << folder << " from " << c.file << "\n";
       std::string what;

@@ -145,12 +145,13 @@ Suite loadSuite(const std::string& path) {
     s.synth.push_back(y);
   });
   forEachTable(path, root, "scan", [&](const toml::table& t) {
-    checkKeys(path, t, {"file", "name", "seeds", "grid", "methods"}, "[[scan]]");
+    checkKeys(path, t, {"file", "name", "seeds", "grid", "move", "methods"}, "[[scan]]");
     SuiteScan c;
     c.file = resolve(text(path, t, "file", "[[scan]]"));
     c.name = text(path, t, "name", "[[scan]]", fs::path(c.file).stem().string());
     c.seeds = list<int64_t>(path, t, "seeds", c.seeds);
     c.grid = number(path, t, "grid", c.grid);
+    c.move = number(path, t, "move", c.move);
     c.methods = blockMethods(t);
     if (!fs::exists(c.file))
       s.warnings.push_back("scan '" + c.name + "' left out: " + c.file + ": no such file");

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/matcher.hpp"
+#include "synth/scan_pairs.hpp"
 
 namespace tomomap::cli {
 
@@ -34,6 +35,8 @@ struct SuiteScan {
   std::string name;  ///< family name; default: the file's stem
   std::vector<int64_t> seeds{1};
   double grid = MatchParams{}.grid;  ///< [m]
+  /// The source's largest x, y move [m] (ScanPairParams::move_xy).
+  double move = synth::ScanPairParams{}.move_xy;
   std::vector<std::string> methods;  ///< as for [[synth]]
 };
 

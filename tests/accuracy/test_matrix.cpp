@@ -45,6 +45,8 @@ std::map<std::string, FamilyTally> tallies(const std::filesystem::path& rows) {
 TEST(RegressionMatrix, NoFamilyAnswersWrongOrFewerRightThanItsFloor) {
   // Right answers per family at the last raise of the floors (the matrix's
   // run in docs/results.md). Real-data families are checked where the data is.
+  // sunrgbd g0.05 5 -> 4 with its pairs' source moved within 4 m, not 20: the
+  // same crops, the source's raster at another sub-cell phase (seed 31 refused).
   const std::map<std::string, int> floor = {{"demo-room g0.05", 2},
                                             {"indoor g0.05 x0.5", 10},
                                             {"indoor g0.1 x0.5", 10},
@@ -59,7 +61,7 @@ TEST(RegressionMatrix, NoFamilyAnswersWrongOrFewerRightThanItsFloor) {
                                             {"outdoor g0.5 x0.5", 10},
                                             {"room g0.05", 20},
                                             {"room g0.1", 20},
-                                            {"sunrgbd-room g0.05", 5},
+                                            {"sunrgbd-room g0.05", 4},
                                             {"sunrgbd-room g0.1", 1},
                                             {"nuscenes-lidar g0.2", 0},
                                             {"kitti-lidar g0.2", 3}};

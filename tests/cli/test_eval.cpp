@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -79,21 +80,27 @@ TEST(Eval, MissingMapIsLeftOutAndTheRestRuns) {
 }
 
 // Pairs cut from a scan (here a generated room's map; the real scans beside
-// the repository are used the same way), and the table a regression matrix
-// reads: right, refused and wrong per family.
+// the repository are used the same way), the source moved within `move`, and
+// the table a regression matrix reads: right, refused and wrong per family.
 TEST(Eval, AScanBlockCutsPairsWithGroundTruthAndCountsRightRefusedWrong) {
   TempDir dir;
   const auto gen = runTomomap("synth -w room -s 2 --noise low -o " + (dir / "room"));
   ASSERT_EQ(gen.exit_code, 0) << gen.output;
   const auto r = evalSuite(dir,
                            "name = \"scans\"\nmethods = [\"tomomap\"]\n[[scan]]\nfile = \"room/map_0.pcd\"\n"
-                           "name = \"room-scan\"\nseeds = [1, 2]\ngrid = 0.1\n[[scan]]\nfile = \"nowhere/scan.pcd\"\n");
+                           "name = \"room-scan\"\nseeds = [1, 2]\ngrid = 0.1\nmove = 3\n[[scan]]\n"
+                           "file = \"nowhere/scan.pcd\"\n");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("scan 'scan' left out: "), std::string::npos) << r.output;
   const auto pair = nlohmann::json::parse(slurp(dir / "out/worlds/room-scan-1-g0.1/pair.json"));
   EXPECT_GE(pair["overlap"].get<double>(), 0.2) << pair.dump(2);
   EXPECT_LE(pair["overlap"].get<double>(), 0.6) << pair.dump(2);
   EXPECT_GE(pair["thinning"].get<int>(), 3) << "odd seeds thin one crop";
+  // The source moved no further than the block's `move` (default 20 m).
+  for (const char* axis : {"x", "y"}) {
+    const double d = pair["move"][axis].get<double>();
+    EXPECT_LE(std::abs(d), 3.0) << pair.dump(2);
+  }
   // Every run lands in exactly one of right, refused, wrong or errors.
   const std::string md = slurp(dir / "out/summary.md");
   const std::regex row(R"(\| tomomap \| room-scan g0.1 \| 2 \| ([0-9]) \| ([0-9]) \| ([0-9]) \| ([0-9]) \|)");
