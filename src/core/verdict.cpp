@@ -76,16 +76,19 @@ bool confirmsThin(const DenseEvidence& d, const MatchParams& params) {
 }
 
 /// How a search's best pose measures against leading by `by`: its lead, and
-/// each bar it falls short of (the lead, chance, the slices it holds over), so
-/// that a refusal names what refused it.
-std::string shortfall(const DenseEvidence& d, double by, const MatchParams& params) {
+/// each bar it falls short of (the lead, chance, the `slices` it holds over
+/// of min_support), so that a refusal names what refused it.
+std::string shortfall(const DenseEvidence& d, double by, int slices, const MatchParams& params) {
   std::string out = "lead " + fixed(d.lead(), 2) + "x";
   if (d.lead() < by) out += ", need " + fixed(by, 2) + "x";
   const double sigma = significance(d.best.score(), d.next_score);
   if (sigma < kSignificant) out += "; " + fixed(sigma, 1) + " sigma beyond chance, need " + fixed(kSignificant, 0);
-  if (d.best.support < params.min_support)
-    out += "; over " + std::to_string(d.best.support) + " slices, need " + std::to_string(params.min_support);
+  if (slices < params.min_support)
+    out += "; over " + std::to_string(slices) + " slices, need " + std::to_string(params.min_support);
   return out;
+}
+std::string shortfall(const DenseEvidence& d, double by, const MatchParams& params) {
+  return shortfall(d, by, d.best.support, params);
 }
 
 /// What keeps a search's best pose from counting however far it leads, if anything.
@@ -94,6 +97,16 @@ std::string contradictionNote(const DenseEvidence& d) {
   return "; it lands " + fixed(100 * contradiction(d.best), 0) +
          " % as many telling cells in space the other map saw empty as on its occupancy (at most " +
          fixed(100 * kMostContradicted, 0) + " %)";
+}
+
+/// Why the wide search did not confirm a thin feature answer (confirmsThin):
+/// its best pose elsewhere, or each bar that pose falls short of.
+std::string unconfirmed(const DenseEvidence& d, const MatchParams& params) {
+  const std::string what = "; a search on a raster twice as fine did not confirm it (";
+  if (!d.at_features)
+    return what + "its best pose lies " + fixed(d.apart, 2) + " m, " + fixed(degrees(d.apart_yaw), 1) + " deg and " +
+           fixed(d.apart_height, 2) + " m in height away)";
+  return what + shortfall(d, kDenseOpinion, d.best.support_seen, params) + ")" + contradictionNote(d);
 }
 
 Verdict by(Verdict::By b) { return {b, "", Verdict::Needs::nothing}; }
@@ -140,6 +153,7 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
       if (!e.features_landed) return needs(Verdict::Needs::features_landed);
       return by(e.features_landed->score() >= e.wide->best.score() ? Verdict::By::features : Verdict::By::wide);
     }
+    if (e.wide->found) why += unconfirmed(*e.wide, params);
   }
   if (!e.at_grid) return needs(Verdict::Needs::search_at_grid);
   const DenseEvidence& grid = *e.at_grid;

@@ -93,8 +93,8 @@ TEST(Verdict, TruthTable) {
   add("... then, where it did not confirm them, the dense search", with(featureAnswer(2)), By::none,
       Needs::search_at_grid);
   Evidence confirmed = thinWith(search(landed(1300), 1000, true, 0.2));
-  add("... a wide search whose best pose is the features' and leads 1.3x: the features' landing is asked",
-      confirmed, By::none, Needs::features_landed);
+  add("... a wide search whose best pose is the features' and leads 1.3x: the features' landing is asked", confirmed,
+      By::none, Needs::features_landed);
   confirmed.features_landed = landed(1400);
   add("... and the features' answer stands where it lands more telling cells", confirmed, By::features);
   confirmed.features_landed = landed(1200);
@@ -112,6 +112,20 @@ TEST(Verdict, TruthTable) {
   add("a wide lead of 130 to 100 is chance (1.9 sigma): not confirmed", chance, By::none, Needs::search_at_grid);
   Evidence few = thinWith(search(landed(1300, 0, 2), 1000, true, 0.2));
   add("a wide best pose over 2 slices does not confirm", few, By::none, Needs::search_at_grid);
+  // A refusal names what the wide search fell short of (LiDAR crops, too
+  // large for the dense search, said only "only 2 slice pairs agree").
+  few.at_grid = DenseEvidence{};
+  add("... and the refusal says so", few, By::none, Needs::nothing,
+      "only 1 slice pairs agree (need 3); a search on a raster twice as fine did not confirm it (lead 1.30x; over 2 "
+      "slices, need 3)");
+  chance.at_grid = DenseEvidence{};
+  add("... or that its lead is chance", chance, By::none, Needs::nothing,
+      "only 1 slice pairs agree (need 3); a search on a raster twice as fine did not confirm it (lead 1.30x; 2.0 "
+      "sigma beyond chance, need 3)");
+  elsewhere.at_grid = DenseEvidence{};
+  add("... or where its best pose lies", elsewhere, By::none, Needs::nothing,
+      "only 1 slice pairs agree (need 3); a search on a raster twice as fine did not confirm it (its best pose lies "
+      "2.50 m, 0.0 deg and 0.00 m in height away)");
   add("a weak winner: the dense search is asked", with(featureAnswer(10, 2)), By::none, Needs::search_at_grid);
   add("two answers within min_support pairs are ambiguous", with(featureAnswer(6, 4), DenseEvidence{}, 0.2), By::none,
       Needs::nothing, "ambiguous: another answer 12");
