@@ -176,8 +176,13 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
     ++drawn_pairs;
   }
   if (rows.empty()) {
-    cv::Mat none(80, 700, CV_8UC3, colour::kWhite);
-    drawText(none, "no supporting slice pair to show", {10, 45}, 0.6, colour::kRed);
+    // A dense answer stands on the occupancy alone: no descriptor matches lie behind it.
+    const bool dense = r.reliable && r.method == "dense";
+    cv::Mat none(80, 1000, CV_8UC3, colour::kWhite);
+    drawText(none,
+             dense ? "found by the dense search of the occupancy, not by descriptor matches: see the overlay"
+                   : "no supporting slice pair to show",
+             {10, 45}, 0.6, dense ? colour::kBlack : colour::kRed);
     return none;
   }
   cv::Mat out = stack(rows);
