@@ -99,13 +99,17 @@ std::string contradictionNote(const DenseEvidence& d) {
          fixed(100 * kMostContradicted, 0) + " %)";
 }
 
+/// How far a search's best pose lies from the features' answer, as a refusal says it.
+std::string howFarApart(const DenseEvidence& d) {
+  return fixed(d.apart, 2) + " m, " + fixed(degrees(d.apart_yaw), 1) + " deg and " + fixed(d.apart_height, 2) +
+         " m in height away";
+}
+
 /// Why the wide search did not confirm a thin feature answer (confirmsThin):
 /// its best pose elsewhere, or each bar that pose falls short of.
 std::string unconfirmed(const DenseEvidence& d, const MatchParams& params) {
   const std::string what = "; a search on a raster twice as fine did not confirm it (";
-  if (!d.at_features)
-    return what + "its best pose lies " + fixed(d.apart, 2) + " m, " + fixed(degrees(d.apart_yaw), 1) + " deg and " +
-           fixed(d.apart_height, 2) + " m in height away)";
+  if (!d.at_features) return what + "its best pose lies " + howFarApart(d) + ")";
   return what + shortfall(d, kDenseOpinion, d.best.support_seen, params) + ")" + contradictionNote(d);
 }
 
@@ -181,8 +185,7 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
             shortfall(grid, kDenseOpinion, params) + ")" + contradictionNote(grid);
     else
       why = "the features and a dense search of the occupancy disagree (" + fixed(grid.lead(), 2) +
-            "x lead for a pose " + fixed(grid.apart, 2) + " m, " + fixed(degrees(grid.apart_yaw), 1) + " deg and " +
-            fixed(grid.apart_height, 2) + " m in height away)";
+            "x lead for a pose " + howFarApart(grid) + ")";
   } else {
     if (clear) return by(Verdict::By::at_grid);
     why += "; nor did a dense search of the occupancy find a clear pose (" + shortfall(grid, kDenseLead, params) + ")" +
