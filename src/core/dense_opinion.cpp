@@ -77,6 +77,23 @@ DenseEvidence evidenceOf(const Opinion& o, const MatchResult& r, bool features, 
   return d;
 }
 
+/// The search that found `o` asked again with the maps' roles swapped, its
+/// best pose turned back against `o`'s (verdict.hpp).
+SecondLook lookAgain(const Opinion& o, const MapFeatures& target, const MapFeatures& source,
+                     const MatchParams& params) {
+  const SliceStack& t = target.occupancy;
+  const SliceStack& s = source.occupancy;
+  const Opinion back = o.pooling > 1 ? searchAt(source, target, pooled(s), pooled(t), o.pooling, params)
+                                     : searchAt(source, target, s, t, 1, params);
+  SecondLook look;
+  look.found = back.found();
+  if (!look.found) return look;
+  const Rigid2D turned = back.best().transform.inverse();
+  look.same_place = isBestPose(o, turned, -back.best().offset, source);
+  look.apart = (turned.t - o.best().transform.t).norm();
+  return look;
+}
+
 /// `r` answered by the opinion's best pose (`method` "dense"); `e`, the verdict's view of it.
 void answer(MatchResult& r, const Opinion& o, const DenseEvidence& e, const MapFeatures& target,
             const MapFeatures& source) {
@@ -136,6 +153,9 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
         at_pooled = searchAt(target, source, pooled(target.occupancy), pooled(source.occupancy), 2, params);
         e.pooled = evidenceOf(*at_pooled, r, features, target, source);
         if (at_pooled->found()) r.dense_pooled_lead = e.pooled->lead();
+        break;
+      case Verdict::Needs::second_look:
+        e.second_look = lookAgain(v.by == Verdict::By::pooled ? *at_pooled : *at_grid, target, source, params);
         break;
       case Verdict::Needs::nothing:
         break;

@@ -10,7 +10,7 @@ namespace tomomap {
 /// Settles `r` (matchFeatures' figures from the features, `e` their evidence)
 /// on the verdict: gathers what decideMatch asks for (the dense search at the
 /// maps' grid, the features' answer landed, the search on occupancy pooled to
-/// twice the cell), records each search's figures in `r`, and answers from
+/// twice the cell, a second look at the pose that would answer), records each search's figures in `r`, and answers from
 /// the search the verdict names. Small maps get this second opinion because
 /// few slices and a 31-pixel ORB patch spanning most of the image leave the
 /// tomographic match refusing or, with noisy walls, fooled by a half-turned

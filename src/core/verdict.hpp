@@ -50,15 +50,26 @@ struct FeatureEvidence {
 /// What one dense search found (dense_opinion.cpp), its best pose against the
 /// features' answer where there is one.
 struct DenseEvidence {
-  bool found = false;     ///< searched, and found at least one pose
-  DensePose best;         ///< its best pose (found only)
-  double next_score = 0;  ///< its next pose's score; 0 if it found one only
-  double cell = 0;        ///< of the occupancy searched [m]
+  bool found = false;        ///< searched, and found at least one pose
+  DensePose best;            ///< its best pose (found only)
+  double next_score = 0;     ///< its next pose's score; 0 if it found one only
+  double cell = 0;           ///< of the occupancy searched [m]
   bool at_features = false;  ///< its best pose is the features' answer (same place, within the smear of heights)
   double apart = 0, apart_yaw = 0, apart_height = 0;  ///< how far its best pose is from the features' [m, rad, m]
 
   /// The best pose's score over its next's; 0 where even the best contradicts more than it finds.
   double lead() const;
+};
+
+/// The search whose best pose would answer, asked again with the maps' roles
+/// swapped (the target's cells landed on the source's raster): a second look
+/// at the same occupancy, its best pose turned back to map the source onto
+/// the target.
+struct SecondLook {
+  bool found = false;  ///< it found a pose
+  bool same_place =
+      false;         ///< that pose is the answer's (same place at the source's centre, within the smear of heights)
+  double apart = 0;  ///< where the two put the source's frame origin, apart [m]
 };
 
 /// All the verdict weighs. The optional parts are gathered when the verdict
@@ -71,21 +82,24 @@ struct Evidence {
   std::optional<DenseEvidence> wide;         ///< the same on a raster twice as fine (kWideCoarseSide)
   std::optional<DensePose> features_landed;  ///< the features' answer landed on the maps' own occupancy
   std::optional<DenseEvidence> pooled;       ///< the dense search on occupancy pooled to twice the cell
+  std::optional<SecondLook> second_look;     ///< of the search whose pose would answer (Needs::second_look)
 };
 
 struct Verdict {
   enum class By { none, features, at_grid, wide, pooled };
-  By by = By::none;    ///< which search's answer is the answer; none: no reliable match
+  /// Which search's answer is the answer; none: no reliable match. With
+  /// Needs::second_look, the search whose pose would answer.
+  By by = By::none;
   std::string reason;  ///< why there is none
   /// Evidence the verdict needs before it can decide: gather it and ask again.
-  enum class Needs { nothing, search_at_grid, wide_search, features_landed, pooled_search };
+  enum class Needs { nothing, search_at_grid, wide_search, features_landed, pooled_search, second_look };
   Needs needs = Needs::nothing;
 };
 
 /// The verdict on `e`. A feature answer that leads its runner-up clearly
 /// (weakWinner) stands alone. One on fewer than min_support slice pairs
 /// stands where the wide search's best pose lands on it and confirms it
-/// (kDenseOpinion, beyond chance, over min_support of the slices that land
+/// (kDenseOpinion, beyond chance, over kConfirmingSlices of the slices that land
 /// where the other map saw anything): the one of the two poses that lands
 /// more telling cells is the answer. Otherwise the dense search at the map's grid
 /// confirms it (its best pose is the features' and leads by kDenseOpinion),
@@ -96,7 +110,10 @@ struct Verdict {
 /// pose. Where that leaves no answer and the pooled cell stays fine enough,
 /// the search on pooled occupancy answers with a clear pose of its own. Every
 /// lead must also be beyond chance (kSignificant) and its pose hold
-/// (kMostContradicted, min_support slices).
+/// (kMostContradicted, min_support slices). The pose of a dense search that
+/// answers alone (at the map's grid or pooled) answers only where the same
+/// search with the maps' roles swapped finds it again and puts the source's
+/// frame origin where it does (preciseWhereStated).
 Verdict decideMatch(const Evidence& e, const MatchParams& params);
 
 }  // namespace tomomap

@@ -52,14 +52,25 @@ struct Row {
   const char* reason;  ///< the reason begins so (by none, needs nothing)
 };
 
+/// A second look at a dense pose that finds it again, its origin `apart` [m] away.
+SecondLook lookedAgain(double apart = 0) {
+  SecondLook l;
+  l.found = true;
+  l.same_place = true;
+  l.apart = apart;
+  return l;
+}
+
 /// The evidence of a row; a thin feature answer's wide search (asked first)
-/// found nothing unless the row says otherwise.
+/// found nothing unless the row says otherwise, and a second look at a dense
+/// pose finds it again.
 Evidence with(FeatureEvidence f, std::optional<DenseEvidence> grid = std::nullopt, double cell = 0.1) {
   Evidence e;
   e.features = std::move(f);
   e.grid = cell;
   e.at_grid = std::move(grid);
   e.wide = DenseEvidence{};
+  e.second_look = lookedAgain();
   return e;
 }
 
@@ -110,14 +121,17 @@ TEST(Verdict, TruthTable) {
       Needs::search_at_grid);
   Evidence chance = thinWith(search(landed(130), 100, true, 0.2));
   add("a wide lead of 130 to 100 is chance (1.9 sigma): not confirmed", chance, By::none, Needs::search_at_grid);
-  Evidence few = thinWith(search(landed(1300, 0, 2), 1000, true, 0.2));
-  add("a wide best pose over 2 slices does not confirm", few, By::none, Needs::search_at_grid);
+  Evidence two = thinWith(search(landed(1300, 0, 2), 1000, true, 0.2));
+  two.features_landed = landed(1400);
+  add("a wide best pose over 2 slices confirms (kitti-lidar-16: 2.05x over 2 slices)", two, By::features);
+  Evidence few = thinWith(search(landed(1300, 0, 1), 1000, true, 0.2));
+  add("a wide best pose over 1 slice does not confirm", few, By::none, Needs::search_at_grid);
   // A refusal names what the wide search fell short of (LiDAR crops, too
   // large for the dense search, said only "only 2 slice pairs agree").
   few.at_grid = DenseEvidence{};
   add("... and the refusal says so", few, By::none, Needs::nothing,
-      "only 1 slice pairs agree (need 3); a search on a raster twice as fine did not confirm it (lead 1.30x; over 2 "
-      "slices, need 3)");
+      "only 1 slice pairs agree (need 3); a search on a raster twice as fine did not confirm it (lead 1.30x; over 1 "
+      "slices, need 2)");
   chance.at_grid = DenseEvidence{};
   add("... or that its lead is chance", chance, By::none, Needs::nothing,
       "only 1 slice pairs agree (need 3); a search on a raster twice as fine did not confirm it (lead 1.30x; 2.0 "
@@ -164,6 +178,28 @@ TEST(Verdict, TruthTable) {
       "2 slices, need 3)");
   add("a refused feature match is answered by a clear dense pose", with(featureAnswer(1), search(landed(2000), 1000)),
       By::at_grid);
+  Evidence unlooked = with(featureAnswer(1), search(landed(2000), 1000));
+  unlooked.second_look.reset();
+  add("a dense pose that would answer: a second look, the maps' roles swapped, is asked", unlooked, By::at_grid,
+      Needs::second_look);
+  Evidence near = with(featureAnswer(1), search(landed(2000), 1000));
+  near.second_look = lookedAgain(0.6);
+  add("... it answers where that puts the source's origin within sqrt(2) x 5 cells (0.71 m at g 0.1)", near,
+      By::at_grid);
+  Evidence far = with(featureAnswer(1), search(landed(2000), 1000, false, 0.05), 0.05);
+  far.second_look = lookedAgain(0.41);
+  add("... and is refused where farther (sunrgbd-room-156 at g 0.05: 0.41 m, 0.51 m off)", far, By::none,
+      Needs::nothing,
+      "a dense search's pose was not found again with the maps' roles swapped: that search puts the source's frame "
+      "origin 0.41 m from it (within 0.35 m: two looks, each within 5 cells)");
+  Evidence lost = with(featureAnswer(1), search(landed(2000), 1000));
+  lost.second_look->same_place = false;
+  add("... or where the second look's best pose lies elsewhere", lost, By::none, Needs::nothing,
+      "a dense search's pose was not found again with the maps' roles swapped: that search's best pose lies elsewhere");
+  Evidence wide_unlooked = thinWith(search(landed(1300), 1000, true, 0.2));
+  wide_unlooked.features_landed = landed(1200);
+  wide_unlooked.second_look.reset();
+  add("the wide search's pose needs none: the features' answer was its second look", wide_unlooked, By::wide);
   add("a dense best pose that contradicts the empty space: the features' own landing is asked",
       with(featureAnswer(10, 2), search(landed(1000, 600), 100)), By::none, Needs::features_landed);
 
