@@ -74,6 +74,9 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
     if (r.dense_wide_lead > 0)
       out << format("                 on a raster twice as fine, checking the features' answer: %.2fx\n",
                     r.dense_wide_lead);
+    if (r.dense_second_look_apart)
+      out << format("                 with the maps' roles swapped, the source's origin %.3f m from its pose\n",
+                    *r.dense_second_look_apart);
     out << "tilt             target " << tiltText(r.target_tilt) << ", source " << tiltText(r.source_tilt) << "\n";
     out << format(
         "slices           target %d (%zu features), source %d (%zu features), %zu of %zu slice pairs matched\n",
@@ -109,6 +112,8 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
                   {"dense_cell", r.dense_cell},
                   {"dense_pooled_lead", r.dense_pooled_lead},
                   {"dense_wide_lead", r.dense_wide_lead},
+                  {"dense_second_look_m",
+                   r.dense_second_look_apart ? nlohmann::json(*r.dense_second_look_apart) : nlohmann::json()},
                   {"support", r.support},
                   {"height_offset_slices", r.height_offset},
                   {"runner_up_support", r.runner_up_support},

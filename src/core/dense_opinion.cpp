@@ -156,6 +156,7 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
         break;
       case Verdict::Needs::second_look:
         e.second_look = lookAgain(v.by == Verdict::By::pooled ? *at_pooled : *at_grid, target, source, params);
+        if (e.second_look->found) r.dense_second_look_apart = e.second_look->apart;
         break;
       case Verdict::Needs::nothing:
         break;

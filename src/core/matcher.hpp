@@ -58,6 +58,10 @@ struct MatchResult {
   /// The lead of the search on a raster twice as fine, asked where the
   /// features found an answer on too few slice pairs (verdict.hpp); 0 when it did not run.
   double dense_wide_lead = 0;
+  /// Where the dense search with the maps' roles swapped put the source's
+  /// frame origin, apart from the dense answer's [m] (verdict.hpp,
+  /// SecondLook); unset when it was not asked or found no pose.
+  std::optional<double> dense_second_look_apart;
   int support = 0;            ///< agreeing slice pairs at the winning height offset
   int runner_up_support = 0;  ///< best support of another answer (OffsetChoice)
   int runner_up_offset = 0;   ///< its height offset [slices]

@@ -144,12 +144,20 @@ TEST(SmallRooms, SucceedLikeTallMapsAtTheirGridAndAreNeverAnsweredWrong) {
 // in the other's open floor space; counted against the pose, the right one
 // now leads by 1.66-2.81x and answers alone (docs/algorithm.md, "Empty space").
 TEST(SmallRooms, EmptySpaceTheOtherMapSawTellsARoomFromItsHalfTurn) {
+  int looked_again = 0;
   for (const uint64_t seed : {2, 3, 6}) {
     const RoomMatch m = matchRoom(seed, "high", 0.1);
     expectAnsweredRightBy(m, 0.1, "dense", "seed " + std::to_string(seed));
     EXPECT_GE(m.result.dense_lead, 1.4) << "seed " << seed;
     EXPECT_EQ(m.result.dense_pooled_lead, 0.0) << "seed " << seed << ": not the grid's search alone";
+    // The grid's search answering alone had a second look, the maps' roles
+    // swapped, and it put the source's origin within two looks' tolerance
+    // (sqrt(2) x 5 cells); the wide search's answer (seed 3) had the features'.
+    if (!m.result.dense_second_look_apart) continue;
+    ++looked_again;
+    EXPECT_LE(*m.result.dense_second_look_apart, std::sqrt(2.0) * 5 * 0.1) << "seed " << seed;
   }
+  EXPECT_GE(looked_again, 1) << "no answer had a second look";
 }
 
 // The right pose need not be among the search's candidates: on a held-out
@@ -208,8 +216,8 @@ TEST(SmallRooms, AFeatureAnswerTheDenseSearchDoesNotConfirmIsRefused) {
 // dense pose replaces a feature answer stays (Verdict.*).
 TEST(SmallRooms, ANarrowFeatureWinnerForAHalfTurnedRoomIsNotTheAnswer) {
   const RoomMatch m = matchRoom(150, "high", 0.1);
-  EXPECT_TRUE(m.result.reliable && m.right(0.1)) << m.result.reason << " " << m.error.translation << " m off ("
-                                                 << m.result.method << ")";
+  EXPECT_TRUE(m.result.reliable && m.right(0.1))
+      << m.result.reason << " " << m.error.translation << " m off (" << m.result.method << ")";
 }
 
 // At g 0.05 a room's 5 cm of wall noise splits its walls across neighbouring
