@@ -38,7 +38,8 @@ constexpr double kDenseOpinion = 1.2;
 /// At min_support the matrix's kitti-lidar-16 (features on 2 slice pairs, the
 /// wide search's best pose theirs, 2.05x ahead, over 2 slices) was refused,
 /// which the paper's method answers right; at 2 it is answered, 0.07 m off,
-/// and nothing else changed on the matrix and real-scan seeds 1-300 (1,478 pairs).
+/// and nothing else changed on the matrix, real-scan seeds 1-300 and rooms
+/// seeds 1-100 (1,878 pairs).
 constexpr int kConfirmingSlices = 2;
 /// Pooled occupancy is searched only where its cell stays this fine [m]
 /// (maps at g 0.1 and finer): room pairs were measured up to there.
@@ -126,19 +127,20 @@ Verdict none(std::string reason) { return {Verdict::By::none, std::move(reason),
 Verdict needs(Verdict::Needs n) { return {Verdict::By::none, "", n}; }
 
 /// The answer `b`, the pose of a dense search that answers alone (a wide
-/// search's pose has the features' answer for a second look), where a
-/// second look at the occupancy (the same search, the maps' roles swapped) finds that pose again
-/// and puts the source's frame origin within sqrt(2) consensus tolerances of
-/// where it does. The transform is stated at that origin, which may lie
-/// metres from what the maps share, where a yaw error the shared cells cannot
-/// tell (a degree or two on a crop a metre across) moves it by more than the
-/// tolerance. Two looks of equal spread lie sqrt(2) times one's error apart,
-/// so within that, the answer's error is within the tolerance. Real RGB-D
-/// crops (sunrgbd seeds 1-300, g 0.05 and 0.1): right dense answers' looks
-/// 0.2-5.7 cells apart, wrong ones' 3.7-12.9 (0.28-1.35 m off); room pairs
-/// (seeds 1-100), every answer right, at most 2.5. Asked of the wide
-/// search's pose too, it refused the two right answers that search gave on
-/// the matrix's LiDAR crops (kitti-lidar-10, 16): swapped, it found another.
+/// search's pose has the features' answer for a second look), where a second
+/// look at the occupancy (the same search, the maps' roles swapped) finds
+/// that pose again and puts the source's frame origin within sqrt(2)
+/// consensus tolerances of where it does. The transform is stated at that
+/// origin, which may lie metres from what the maps share, where a yaw error
+/// the shared cells cannot tell (a degree or two on a crop a metre across)
+/// moves it by more than the tolerance. Two looks of equal spread lie sqrt(2)
+/// times one's error apart, so within that, the answer's error is within the
+/// tolerance. Real RGB-D crops (sunrgbd seeds 1-300, g 0.05 and 0.1): right
+/// dense answers' looks 0.2-5.7 cells apart, wrong ones' 3.7-12.9 (0.28-1.35 m
+/// off); room pairs (seeds 1-100), every answer right, at most 2.5. Asked of
+/// the wide search's pose too, it refused the two right answers that search
+/// gave on the matrix's LiDAR crops (kitti-lidar-10, 16): swapped, it found
+/// another.
 Verdict preciseWhereStated(Verdict::By b, const Evidence& e, const MatchParams& params) {
   if (!e.second_look) return {b, "", Verdict::Needs::second_look};
   const SecondLook& look = *e.second_look;
