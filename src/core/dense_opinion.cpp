@@ -77,14 +77,12 @@ DenseEvidence evidenceOf(const Opinion& o, const MatchResult& r, bool features, 
   return d;
 }
 
-/// The search that found `o` asked again with the maps' roles swapped, its
-/// best pose turned back against `o`'s (verdict.hpp).
-SecondLook lookAgain(const Opinion& o, const MapFeatures& target, const MapFeatures& source,
-                     const MatchParams& params) {
-  const SliceStack& t = target.occupancy;
-  const SliceStack& s = source.occupancy;
-  const Opinion back = o.pooling > 1 ? searchAt(source, target, pooled(s), pooled(t), o.pooling, params)
-                                     : searchAt(source, target, s, t, 1, params);
+/// The search that found `o` on `t` and `s` (the target's and the source's
+/// occupancy as it searched them) asked again with the maps' roles swapped,
+/// its best pose turned back against `o`'s (verdict.hpp).
+SecondLook lookAgain(const Opinion& o, const MapFeatures& target, const MapFeatures& source, const SliceStack& t,
+                     const SliceStack& s, const MatchParams& params) {
+  const Opinion back = searchAt(source, target, s, t, o.pooling, params);
   SecondLook look;
   look.found = back.found();
   if (!look.found) return look;
@@ -133,6 +131,7 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
   const auto t0 = std::chrono::steady_clock::now();
   const bool features = r.support > 0;  // the features proposed an answer (judged or not)
   std::optional<Opinion> at_grid, wide, at_pooled;
+  std::optional<SliceStack> pooled_target, pooled_source;  // kept for the pooled pose's second look
   Verdict v;
   while ((v = decideMatch(e, params)).needs != Verdict::Needs::nothing) {
     switch (v.needs) {
@@ -150,12 +149,16 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
         e.features_landed = landPose(target.occupancy, source.occupancy, planar(r.T_target_source), r.height_offset);
         break;
       case Verdict::Needs::pooled_search:
-        at_pooled = searchAt(target, source, pooled(target.occupancy), pooled(source.occupancy), 2, params);
+        pooled_target = pooled(target.occupancy);
+        pooled_source = pooled(source.occupancy);
+        at_pooled = searchAt(target, source, *pooled_target, *pooled_source, 2, params);
         e.pooled = evidenceOf(*at_pooled, r, features, target, source);
         if (at_pooled->found()) r.dense_pooled_lead = e.pooled->lead();
         break;
       case Verdict::Needs::second_look:
-        e.second_look = lookAgain(v.by == Verdict::By::pooled ? *at_pooled : *at_grid, target, source, params);
+        e.second_look = v.by == Verdict::By::pooled
+                            ? lookAgain(*at_pooled, target, source, *pooled_target, *pooled_source, params)
+                            : lookAgain(*at_grid, target, source, target.occupancy, source.occupancy, params);
         if (e.second_look->found) r.dense_second_look_apart = e.second_look->apart;
         break;
       case Verdict::Needs::nothing:

@@ -67,8 +67,8 @@ struct DenseEvidence {
 /// the target.
 struct SecondLook {
   bool found = false;  ///< it found a pose
-  bool same_place =
-      false;         ///< that pose is the answer's (same place at the source's centre, within the smear of heights)
+  /// That pose is the answer's (the same place at the source's centre, within the smear of heights).
+  bool same_place = false;
   double apart = 0;  ///< where the two put the source's frame origin, apart [m]
 };
 
