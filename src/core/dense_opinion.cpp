@@ -6,6 +6,7 @@
 #include "dense_refine.hpp"
 #include "dense_search.hpp"
 #include "height_offsets.hpp"
+#include "nearby_poses.hpp"
 
 namespace tomomap {
 namespace {
@@ -161,6 +162,14 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
                             : lookAgain(*at_grid, target, source, target.occupancy, source.occupancy, params);
         if (e.second_look->found) r.dense_second_look_apart = e.second_look->apart;
         break;
+      case Verdict::Needs::around_features: {
+        const int tolerance = static_cast<int>(params.consensus_translation_cells);
+        DenseSearchParams dp;
+        dp.threads = matchThreads(params);
+        e.around_features = bestAround(target.occupancy, source.occupancy, planar(r.T_target_source), r.height_offset,
+                                       tolerance, kAroundTolerances * tolerance, dp);
+        break;
+      }
       case Verdict::Needs::nothing:
         break;
     }

@@ -133,8 +133,7 @@ struct Tally {
 };
 
 Tally countInliers(const std::vector<cv::Mat>& dilated, const std::vector<Cell>& cells, const std::vector<int>& landing,
-                   int offset, int source_slices, const Enclosure* enclosure = nullptr,
-                   const cv::Mat* seen = nullptr) {
+                   int offset, int source_slices, const Enclosure* enclosure = nullptr, const cv::Mat* seen = nullptr) {
   Tally t;
   std::vector<size_t> on(static_cast<size_t>(source_slices), 0), all(on), all_seen(on);
   for (size_t n = 0; n < cells.size(); ++n) {
@@ -224,13 +223,15 @@ struct PoseJudge {
 
 std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& source,
                                  const std::vector<std::pair<Rigid2D, int>>& poses, const DenseSearchParams& params) {
-  std::vector<DensePose> out;
-  if (poses.empty() || target.partial || source.partial) return out;
+  if (poses.empty() || target.partial || source.partial) return {};
   const PoseJudge judge(target, source, params);
-  for (const auto& [T, offset] : poses) {
-    DensePose p{T, offset, 0};
+  std::vector<DensePose> out(poses.size());
+#pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
+  for (size_t n = 0; n < poses.size(); ++n) {
+    const auto& [T, offset] = poses[n];
+    DensePose& p = out[n];
+    p.transform = T, p.offset = offset;
     judge.judge(p, judge.forth(landings(judge.source_cells, T, target.grid), offset));
-    out.push_back(p);
   }
   return out;
 }
@@ -268,8 +269,8 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
 
   const SliceGrid& tg = target.grid;
   const SliceGrid& sg = source.grid;
-  const int c = std::max({coarsening(target, params.coarse_side), coarsening(source, params.coarse_side),
-                          params.min_coarsening});
+  const int c =
+      std::max({coarsening(target, params.coarse_side), coarsening(source, params.coarse_side), params.min_coarsening});
   const double C = c * tg.cell;  // coarse cell [m]
 
   // Target: coarse binary images, one per c slices.

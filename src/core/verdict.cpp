@@ -45,13 +45,18 @@ constexpr int kConfirmingSlices = 2;
 /// (maps at g 0.1 and finer): room pairs were measured up to there.
 constexpr double kCoarsestPooledCell = 0.2;
 
+/// Whether another feature answer has almost as much support as the winner.
+bool ambiguous(const FeatureEvidence& f, const MatchParams& params) {
+  return f.runner_up_support > 0 && (f.support - f.runner_up_support < params.min_support ||
+                                     static_cast<double>(f.support) < kClearAhead * f.runner_up_support);
+}
+
 /// Why the features' answer is no reliable match on its own; empty if it is one.
 std::string featureRefusal(const FeatureEvidence& f, const MatchParams& params) {
   if (!f.missing.empty()) return f.missing;
   if (f.support < params.min_support)
     return "only " + std::to_string(f.support) + " slice pairs agree (need " + std::to_string(params.min_support) + ")";
-  if (f.runner_up_support > 0 && (f.support - f.runner_up_support < params.min_support ||
-                                  static_cast<double>(f.support) < kClearAhead * f.runner_up_support))
+  if (ambiguous(f, params))
     return "ambiguous: another answer " + std::to_string(f.runner_up_gap) +
            " slices away has almost as much support (" + std::to_string(f.support) + " vs " +
            std::to_string(f.runner_up_support) + " slice pairs)";
@@ -83,6 +88,15 @@ bool thinFeatureAnswer(const FeatureEvidence& f, const MatchParams& params) {
 bool confirmsThin(const DenseEvidence& d) {
   return d.at_features && aheadBeyondChance(d, kDenseOpinion) && consistent(d.best) &&
          d.best.support_seen >= kConfirmingSlices;
+}
+
+/// Whether a pose found otherwise (the features' answer, landed) lands more
+/// telling cells than a pose that scores `other`: `by` times as many, beyond
+/// chance, holding over min_support of the slices that land where the other
+/// map saw anything.
+bool outscores(const DensePose& p, double other, double by, const MatchParams& params) {
+  return consistent(p) && p.support_seen >= params.min_support && p.score() >= by * std::max(other, 1.0) &&
+         significance(p.score(), other) >= kSignificant;
 }
 
 /// How a search's best pose measures against leading by `by`: its lead, and
@@ -195,6 +209,25 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
       return by(e.features_landed->score() >= e.wide->best.score() ? Verdict::By::features : Verdict::By::wide);
     }
     if (e.wide->found) why += unconfirmed(*e.wide);
+    // The wide search's coarse raster (6 grid cells on a LiDAR crop) can miss
+    // the pose the features found: on kitti crops (seeds 1-300) it ranked a
+    // pose elsewhere first where the features' right pose landed 1.7-2.8
+    // times as much. That pose answers as the search's own best would
+    // (kDenseLead ahead, beyond chance, over min_support slices), where the
+    // occupancy pins it down: no pose around it lands as much within chance.
+    if (e.wide->found && !e.wide->at_features) {
+      if (!e.features_landed) return needs(Verdict::Needs::features_landed);
+      const DensePose& landed = *e.features_landed;
+      if (outscores(landed, e.wide->best.score(), kDenseLead, params)) {
+        if (!e.around_features) return needs(Verdict::Needs::around_features);
+        const DensePose& near = *e.around_features;
+        if (outscores(landed, near.score(), 1, params)) return by(Verdict::By::features);
+        why += "; the features' pose lands " + fixed(landed.score(), 0) + " telling cells, one " +
+               fixed((near.transform.t - landed.transform.t).norm(), 2) + " m from it " + fixed(near.score(), 0) +
+               " (" + fixed(significance(landed.score(), near.score()), 1) + " sigma beyond chance, need " +
+               fixed(kSignificant, 0) + "): the occupancy does not pin it down";
+      }
+    }
   }
   if (!e.at_grid) return needs(Verdict::Needs::search_at_grid);
   const DenseEvidence& grid = *e.at_grid;

@@ -117,7 +117,31 @@ TEST(Verdict, TruthTable) {
   crop.features_landed = landed(1400);
   add("... its slices judged on the cells that land where the other map saw anything", crop, By::features);
   Evidence elsewhere = thinWith(search(landed(1300), 1000, false, 0.2));
-  add("a wide search whose best pose is elsewhere confirms nothing: the dense search is asked", elsewhere, By::none,
+  add("a wide search whose best pose is elsewhere: the features' landing is asked", elsewhere, By::none,
+      Needs::features_landed);
+  // The wide search's coarse raster can miss the features' pose (kitti crops).
+  Evidence missed = elsewhere;
+  missed.features_landed = landed(2000);
+  add("... where that lands 1.5x its best pose's, the poses around it are asked", missed, By::none,
+      Needs::around_features);
+  missed.around_features = landed(1500);
+  add("... and the features' answer stands where it lands more than any of those, beyond chance", missed, By::features);
+  missed.around_features = landed(1950);
+  add("... and not where one lands within chance of it (0.8 sigma)", missed, By::none, Needs::search_at_grid);
+  missed.at_grid = DenseEvidence{};
+  add("... a refusal that says so", missed, By::none, Needs::nothing,
+      "only 1 slice pairs agree (need 3); a search on a raster twice as fine did not confirm it (its best pose lies "
+      "2.50 m, 0.0 deg and 0.00 m in height away); the features' pose lands 2000 telling cells, one 0.00 m from it "
+      "1950 (0.8 sigma beyond chance, need 3): the occupancy does not pin it down");
+  Evidence landed_thin = elsewhere;
+  landed_thin.features_landed = landed(2000, 0, 2);
+  add("a features' landing over 2 slices does not outscore the wide search's pose", landed_thin, By::none,
+      Needs::search_at_grid);
+  Evidence short_lead = elsewhere;
+  short_lead.features_landed = landed(1700);
+  add("nor one landing 1.3x as much as it", short_lead, By::none, Needs::search_at_grid);
+  elsewhere.features_landed = landed(1000);
+  add("a features' pose landing less than the wide search's best: the dense search is asked", elsewhere, By::none,
       Needs::search_at_grid);
   Evidence chance = thinWith(search(landed(130), 100, true, 0.2));
   add("a wide lead of 130 to 100 is chance (1.9 sigma): not confirmed", chance, By::none, Needs::search_at_grid);
