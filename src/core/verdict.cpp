@@ -76,9 +76,12 @@ bool leads(const DenseEvidence& d, double by, const MatchParams& params) {
   return aheadBeyondChance(d, by) && holdsOver(d.best, params.min_support);
 }
 
-/// A feature answer on too few slice pairs to stand alone.
+/// A feature answer on too little evidence to stand alone: too few slice
+/// pairs, or too few inliers for a clear winner.
 bool thinFeatureAnswer(const FeatureEvidence& f, const MatchParams& params) {
-  return f.missing.empty() && f.support > 0 && f.support < params.min_support;
+  if (!f.missing.empty() || f.support <= 0) return false;
+  return f.support < params.min_support ||
+         (!ambiguous(f, params) && f.inliers < static_cast<size_t>(params.min_inliers));
 }
 
 /// Whether a search's best pose confirms a thin feature answer it lands on:

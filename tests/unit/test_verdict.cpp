@@ -169,8 +169,21 @@ TEST(Verdict, TruthTable) {
       Needs::nothing, "ambiguous: another answer 12");
   add("a winner under 1.25x its runner-up is ambiguous", with(featureAnswer(30, 25), DenseEvidence{}, 0.2), By::none,
       Needs::nothing, "ambiguous");
-  add("too few inliers", with(few_inliers, DenseEvidence{}, 0.2), By::none, Needs::nothing,
+  add("too few inliers, and no search confirms them", with(few_inliers, DenseEvidence{}, 0.2), By::none, Needs::nothing,
       "only 10 inlier correspondences (need 20)");
+  Evidence few_unchecked = with(few_inliers);
+  few_unchecked.wide.reset();
+  add("a clear winner on too few inliers is checked wide like a thin one (kitti-lidar-268: 15)", few_unchecked,
+      By::none, Needs::wide_search);
+  Evidence few_confirmed = with(few_inliers);
+  few_confirmed.wide = search(landed(1300), 1000, true, 0.2);
+  few_confirmed.features_landed = landed(1400);
+  add("... and answers where it confirms them", few_confirmed, By::features);
+  Evidence ambiguous_few = with(featureAnswer(6, 4));
+  ambiguous_few.features.inliers = 10;
+  ambiguous_few.wide.reset();
+  add("an ambiguous winner is not checked wide, however few its inliers", ambiguous_few, By::none,
+      Needs::search_at_grid);
   add("no dense search possible (large map): a weak winner stands", with(featureAnswer(10, 2), DenseEvidence{}),
       By::features);
   add("no dense search possible, no feature answer: refused", with(none_found, DenseEvidence{}), By::none,
