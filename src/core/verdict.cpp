@@ -66,10 +66,22 @@ std::string featureRefusal(const FeatureEvidence& f, const MatchParams& params) 
   return "";
 }
 
+/// A pose's score over another's (counted as 1 at least); 0 where the pose's is none.
+double leadOver(double score, double other) { return score <= 0 ? 0 : score / std::max(other, 1.0); }
+
+/// Whether a pose's score leads `other` by `by`, beyond chance.
+bool aheadBeyondChance(double score, double other, double by) {
+  return leadOver(score, other) >= by && significance(score, other) >= kSignificant;
+}
+
 /// Whether a search found a best pose that leads its next by `by`, beyond chance.
 bool aheadBeyondChance(const DenseEvidence& d, double by) {
-  return d.found && d.lead() >= by && significance(d.best.score(), d.next_score) >= kSignificant;
+  return d.found && aheadBeyondChance(d.best.score(), d.next_score, by);
 }
+
+/// Whether a pose holds over `slices` of the slices that land where the other
+/// map saw anything (support_seen: crops share 20-60 %).
+bool holdsWhereSeen(const DensePose& p, int slices) { return consistent(p) && p.support_seen >= slices; }
 
 /// Whether a search's best pose leads by `by`, beyond chance, and holds.
 bool leads(const DenseEvidence& d, double by, const MatchParams& params) {
@@ -85,12 +97,9 @@ bool thinFeatureAnswer(const FeatureEvidence& f, const MatchParams& params) {
 }
 
 /// Whether a search's best pose confirms a thin feature answer it lands on:
-/// a confirmation's lead, beyond chance, holding over kConfirmingSlices of the
-/// slices that land where the other map saw anything (support_seen: crops
-/// share 20-60 %).
+/// a confirmation's lead, beyond chance, holding where seen over kConfirmingSlices.
 bool confirmsThin(const DenseEvidence& d) {
-  return d.at_features && aheadBeyondChance(d, kDenseOpinion) && consistent(d.best) &&
-         d.best.support_seen >= kConfirmingSlices;
+  return d.at_features && aheadBeyondChance(d, kDenseOpinion) && holdsWhereSeen(d.best, kConfirmingSlices);
 }
 
 /// Whether a pose found otherwise (the features' answer, landed) lands more
@@ -98,8 +107,7 @@ bool confirmsThin(const DenseEvidence& d) {
 /// chance, holding over min_support of the slices that land where the other
 /// map saw anything.
 bool outscores(const DensePose& p, double other, double by, const MatchParams& params) {
-  return consistent(p) && p.support_seen >= params.min_support && p.score() >= by * std::max(other, 1.0) &&
-         significance(p.score(), other) >= kSignificant;
+  return holdsWhereSeen(p, params.min_support) && aheadBeyondChance(p.score(), other, by);
 }
 
 /// How a search's best pose measures against leading by `by`: its lead, and
@@ -186,7 +194,7 @@ double significance(double a, double b) {
   return (a - b) / std::sqrt(std::max(a + b, 1.0));
 }
 
-double DenseEvidence::lead() const { return best.score() <= 0 ? 0 : best.score() / std::max(next_score, 1.0); }
+double DenseEvidence::lead() const { return leadOver(best.score(), next_score); }
 
 Verdict decideMatch(const Evidence& e, const MatchParams& params) {
   if (!e.tilted.empty()) return none(e.tilted);

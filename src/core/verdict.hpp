@@ -116,16 +116,18 @@ struct Verdict {
 };
 
 /// The verdict on `e`. A feature answer that leads its runner-up clearly
-/// (weakWinner) stands alone. One on fewer than min_support slice pairs
-/// stands where the wide search's best pose lands on it and confirms it
-/// (kDenseOpinion, beyond chance, over kConfirmingSlices of the slices that land
-/// where the other map saw anything): the one of the two poses that lands
-/// more telling cells is the answer. Where the wide search's best pose lies
-/// elsewhere, the features' pose stands if it lands more than that pose does
-/// (kDenseLead, beyond chance, over min_support of those slices) and, beyond
-/// chance, more than any pose around it (kAroundTolerances). Otherwise the dense search at the map's grid
-/// confirms it (its best pose is the features' and leads by kDenseOpinion),
-/// replaces it (its best pose elsewhere leads by kDenseLead), or refuses it;
+/// (weakWinner) stands alone. One on fewer than min_support slice pairs (or a
+/// clear winner on fewer than min_inliers inliers) stands where the wide
+/// search's best pose lands on it and confirms it (kDenseOpinion, beyond
+/// chance, over kConfirmingSlices of the slices that land where the other map
+/// saw anything): the one of the two poses that lands more telling cells is
+/// the answer. Where the wide search's best pose lies elsewhere, the features'
+/// pose stands if it lands more than that pose does (kDenseLead, beyond
+/// chance, over min_support of those slices) and, beyond chance, more than
+/// any pose around it (kAroundTolerances). Otherwise the dense search at the
+/// map's grid confirms it (its best pose is the features' and leads by
+/// kDenseOpinion), replaces it (its best pose elsewhere leads by kDenseLead),
+/// or refuses it;
 /// a search whose best pose contradicts what the other map saw empty found no
 /// place of its own, and the features' answer then stands if its own landing
 /// holds. A match the features did not answer is answered by a clear dense
