@@ -8,8 +8,9 @@
 namespace tomomap::baseline {
 
 MatchResult matchPaperConsensus(const Points& target, const Points& source, MatchParams params) {
-  params.exhaustive = true;  // the paper visits every slice pair once
-  params.level = false;      // and takes the maps as they are
+  params.exhaustive = true;     // the paper visits every slice pair once
+  params.level = false;         // and takes the maps as they are
+  params.sparsest_slice = 0.5;  // cells, where the paper counts width + height points (paper_consensus.hpp)
   StageTimings timings;
   const MapFeatures t = describeMap(target, params, &timings), s = describeMap(source, params, &timings);
   MatchResult r = resultFor(t, s);

@@ -9,8 +9,9 @@
 //
 // It is built from tomomap's own stages (docs/algorithm.md), so it differs
 // from the paper's code only where those do: a slice is descriptive from
-// (width + height) / 2 occupied cells, where the paper's code asks for
-// width + height points, so it sees at least the slices the paper's would.
+// (width + height) / 2 occupied cells (tomomap's own from a quarter), where
+// the paper's code asks for width + height points, so it sees at least the
+// slices the paper's would.
 #include "core/matcher.hpp"
 
 namespace tomomap::baseline {

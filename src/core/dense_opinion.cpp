@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "dense_refine.hpp"
 #include "dense_search.hpp"
@@ -31,15 +32,22 @@ DenseSearchParams wideSearch() {
   return dp;
 }
 
-/// Searches `target` and `source` (the maps' occupancy, or both pooled by
-/// `pooling`) with `dp`, and brings the best pose back to the maps' own grid:
-/// its offset in their slices, its transform refined on their cells.
+/// Which of `own`'s slices is slice 0 of `searched` (`own`'s occupancy, its
+/// full slices, or pooled by `pooling`), the lower of a pooled slice's two.
+int firstSlice(const SliceStack& searched, const SliceStack& own, int pooling) {
+  return static_cast<int>(std::lround((searched.grid.z_min - own.grid.z_min) / own.grid.cell - 0.5 * (pooling - 1)));
+}
+
+/// Searches `t` and `s` (the maps' occupancy, its full slices, or those
+/// pooled by `pooling`) with `dp`, and brings the best pose back to the maps'
+/// own grid: its offset in their slices, its transform refined on their cells.
 Opinion searchAt(const MapFeatures& target, const MapFeatures& source, const SliceStack& t, const SliceStack& s,
                  int pooling, const MatchParams& params, DenseSearchParams dp = {}) {
   dp.threads = matchThreads(params);
   const ConsensusParams same = consensusParams(params, t.grid.cell);
   Opinion o{searchDensely(t, s, same, source.centre(), dp), t.grid.cell, pooling, same};
-  for (DensePose& p : o.search.poses) p.offset *= pooling;
+  const int shift = firstSlice(t, target.occupancy, pooling) - firstSlice(s, source.occupancy, pooling);
+  for (DensePose& p : o.search.poses) p.offset = p.offset * pooling + shift;
   if (pooling > 1 && !o.search.poses.empty()) {
     DensePose& best = o.search.poses.front();
     DenseRefineParams refine;
@@ -112,6 +120,19 @@ void answer(MatchResult& r, const Opinion& o, const DenseEvidence& e, const MapF
   r.inlier_spread = Eigen::Vector3d::Zero();
 }
 
+/// `r`'s pose moved uphill on the maps' occupancy (nearby_poses.hpp), where
+/// that lands more telling cells.
+void climbUphill(MatchResult& r, const MapFeatures& target, const MapFeatures& source, const MatchParams& params) {
+  DenseSearchParams dp;
+  dp.threads = matchThreads(params);
+  const Rigid2D T = planar(r.T_target_source);
+  const DensePose top = uphill(target.occupancy, source.occupancy, T, r.height_offset, dp);
+  if (top.transform.t == T.t && top.transform.yaw == T.yaw && top.offset == r.height_offset) return;
+  r.T_target_source = {top.transform.t.x(), top.transform.t.y(), heightShift(target, source, top.offset),
+                       wrapAngle(top.transform.yaw)};
+  r.height_offset = top.offset;
+}
+
 /// A small map's answer at the height offset where most of the source's
 /// occupancy lands on the target's, within the smear of offsets around its
 /// own: the features' offset is the smear's centre (height_offsets.hpp).
@@ -132,12 +153,18 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
   const auto t0 = std::chrono::steady_clock::now();
   const bool features = r.support > 0;  // the features proposed an answer (judged or not)
   std::optional<Opinion> at_grid, wide, at_pooled;
-  std::optional<SliceStack> pooled_target, pooled_source;  // kept for the pooled pose's second look
+  // The searches that answer alone search the full slices alone (kFullSlice);
+  // the pooled stacks are kept for the pooled pose's second look.
+  std::optional<SliceStack> full_target, full_source, pooled_target, pooled_source;
+  const auto full = [&] {
+    if (!full_target) full_target = fullSlices(target.occupancy), full_source = fullSlices(source.occupancy);
+  };
   Verdict v;
   while ((v = decideMatch(e, params)).needs != Verdict::Needs::nothing) {
     switch (v.needs) {
       case Verdict::Needs::search_at_grid:
-        at_grid = searchAt(target, source, target.occupancy, source.occupancy, 1, params);
+        full();
+        at_grid = searchAt(target, source, *full_target, *full_source, 1, params);
         e.at_grid = evidenceOf(*at_grid, r, features, target, source);
         if (at_grid->found()) r.dense_lead = e.at_grid->lead(), r.dense_cell = at_grid->cell;
         break;
@@ -150,8 +177,9 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
         e.features_landed = landPose(target.occupancy, source.occupancy, planar(r.T_target_source), r.height_offset);
         break;
       case Verdict::Needs::pooled_search:
-        pooled_target = pooled(target.occupancy);
-        pooled_source = pooled(source.occupancy);
+        full();
+        pooled_target = pooled(*full_target);
+        pooled_source = pooled(*full_source);
         at_pooled = searchAt(target, source, *pooled_target, *pooled_source, 2, params);
         e.pooled = evidenceOf(*at_pooled, r, features, target, source);
         if (at_pooled->found()) r.dense_pooled_lead = e.pooled->lead();
@@ -159,7 +187,7 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
       case Verdict::Needs::second_look:
         e.second_look = v.by == Verdict::By::pooled
                             ? lookAgain(*at_pooled, target, source, *pooled_target, *pooled_source, params)
-                            : lookAgain(*at_grid, target, source, target.occupancy, source.occupancy, params);
+                            : lookAgain(*at_grid, target, source, *full_target, *full_source, params);
         if (e.second_look->found) r.dense_second_look_apart = e.second_look->apart;
         break;
       case Verdict::Needs::around_features: {
@@ -179,6 +207,9 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
   if (v.by == Verdict::By::at_grid) answer(r, *at_grid, *e.at_grid, target, source);
   if (v.by == Verdict::By::wide) answer(r, *wide, *e.wide, target, source);
   if (v.by == Verdict::By::pooled) answer(r, *at_pooled, *e.pooled, target, source);
+  // An answer the occupancy weighed is placed by it too; a clear feature winner
+  // (no dense evidence asked for) is placed by its thousands of keypoints.
+  if (r.reliable && (e.at_grid || e.wide)) climbUphill(r, target, source, params);
   if (r.reliable) takeOccupancyHeight(r, target, source);
   r.timings.dense = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -28,6 +28,9 @@ struct MatchParams {
   /// their sensors' planes, and the synthetic building tilted 3 degrees is
   /// answered either way (docs/algorithm.md, "Gravity check").
   double max_tilt = radians(3.0);  ///< [rad]
+  /// Occupied cells a slice needs to be described, as a share of its raster's
+  /// width + height (kSparsestSlice).
+  double sparsest_slice = kSparsestSlice;
   /// Level a map tilted beyond max_tilt (turn its up onto z) where the tilt is
   /// measured well enough (Tilt::levelable), instead of refusing it.
   bool level = true;

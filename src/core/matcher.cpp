@@ -141,7 +141,8 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   Points filtered = voxelFilter(map, params.grid, &corner);
   t.voxel += secondsSince(t0);
   t0 = Clock::now();
-  SliceStack stack = makeSlices(filtered, params.grid, threads, previous ? &previous->occupancy : nullptr);
+  SliceStack stack =
+      makeSlices(filtered, params.grid, threads, previous ? &previous->occupancy : nullptr, params.sparsest_slice);
   const Tilt tilt = tilt_estimate.get();
   // Only a map that would be refused: levelling a level map by the estimate's
   // own error (0.6 deg on demo-pcd1) cost 3 cm and 0.6 deg on demo-room.
@@ -150,7 +151,7 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   if (level) {
     // The levelled map is filtered again: rotated voxels no longer sit on the grid.
     filtered = voxelFilter(rotatePoints(filtered, tilt.leveling()), params.grid);
-    stack = makeSlices(filtered, params.grid, threads);
+    stack = makeSlices(filtered, params.grid, threads, nullptr, params.sparsest_slice);
   }
   if (filtered_points) *filtered_points = filtered.size();
   t.slicing += secondsSince(t0);

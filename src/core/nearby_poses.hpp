@@ -1,5 +1,6 @@
 #pragma once
-// How well the occupancy pins a pose down: the best of the poses around it.
+// The poses near a pose on the maps' occupancy: how well the occupancy pins it
+// down (the best of the poses around it), and the pose uphill of it.
 #include "dense_search.hpp"
 
 namespace tomomap {
@@ -14,5 +15,18 @@ namespace tomomap {
 /// either stack is partial.
 DensePose bestAround(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset, int inner_cells,
                      int outer_cells, const DenseSearchParams& params = {});
+
+/// The pose uphill of (T, offset): it climbs, one step at a time while a step
+/// lands more telling cells (landPoses): a grid cell in x or y, the yaw that
+/// moves the source raster's corner by a cell (turning about its centre), a
+/// slice in height. Where it stops, it is refined on the occupancy
+/// (refineOnOccupancy: nearest cells, not the count) and climbs again, while
+/// that lands more. A dense search's pose is refined from its coarse cell,
+/// within a few cells, and a feature answer on a few slice pairs is a few
+/// pixels' keypoints: on real crops both stopped short of the right pose,
+/// 0.35-1.7 m and 3-7 deg off it, where the right pose landed 13-48 % more.
+/// (T, offset) itself, landed, where nothing uphill lands more or either stack is partial.
+DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
+                 const DenseSearchParams& params = {});
 
 }  // namespace tomomap

@@ -32,7 +32,24 @@ cv::Rect SliceStack::occupiedArea(int k) const {
   return {static_cast<int>(u0), static_cast<int>(v0), static_cast<int>(u1 - u0 + 1), static_cast<int>(v1 - v0 + 1)};
 }
 
-SliceStack makeSlices(const Points& points, double cell, int threads, const SliceStack* keep) {
+namespace {
+
+/// Drops `stack`'s empty slices at the bottom and top; the others keep their heights.
+void trimEnds(SliceStack& stack) {
+  auto& cells = stack.cells;
+  auto first = std::find_if(cells.begin(), cells.end(), [](const auto& c) { return !c.empty(); });
+  auto last = std::find_if(cells.rbegin(), cells.rend(), [](const auto& c) { return !c.empty(); }).base();
+  if (first >= last) {
+    cells.clear();
+    return;
+  }
+  stack.grid.z_min = stack.grid.sliceHeight(static_cast<int>(first - cells.begin()));
+  cells = std::vector<std::vector<uint32_t>>(std::make_move_iterator(first), std::make_move_iterator(last));
+}
+
+}  // namespace
+
+SliceStack makeSlices(const Points& points, double cell, int threads, const SliceStack* keep, double sparsest) {
   if (!(cell > 0.0)) throw InputError("grid size must be positive");
   SliceStack stack;
   if (points.empty()) return stack;
@@ -96,10 +113,7 @@ SliceStack makeSlices(const Points& points, double cell, int threads, const Slic
       if (const auto at = place(p)) grouped[next[at->first]++] = at->second;
   }
 
-  // Half of the customary minimum (width + height cells): a noise-free street's two
-  // facades are thin lines about as long as the image, and the full threshold
-  // dropped exactly the slices that describe it.
-  const size_t min_cells = static_cast<size_t>(g.width + g.height) / 2;
+  const auto min_cells = static_cast<size_t>(sparsest * (g.width + g.height));
   const size_t raster_words = (static_cast<size_t>(g.width) * static_cast<size_t>(g.height) + 63) / 64;
   auto& cells = stack.cells;
   cells.resize(slices);
@@ -127,15 +141,17 @@ SliceStack makeSlices(const Points& points, double cell, int threads, const Slic
     }
   }
 
-  auto first = std::find_if(cells.begin(), cells.end(), [](const auto& c) { return !c.empty(); });
-  auto last = std::find_if(cells.rbegin(), cells.rend(), [](const auto& c) { return !c.empty(); }).base();
-  if (first >= last) {
-    cells.clear();
-    return stack;
-  }
-  g.z_min = g.sliceHeight(static_cast<int>(first - cells.begin()));
-  cells = std::vector<std::vector<uint32_t>>(std::make_move_iterator(first), std::make_move_iterator(last));
+  trimEnds(stack);
   return stack;
+}
+
+SliceStack fullSlices(const SliceStack& stack) {
+  SliceStack out = stack;
+  const auto min_cells = static_cast<size_t>(kFullSlice * (stack.grid.width + stack.grid.height));
+  for (auto& c : out.cells)
+    if (c.size() < min_cells) std::vector<uint32_t>().swap(c);
+  trimEnds(out);
+  return out;
 }
 
 SliceStack pooled(const SliceStack& fine) {

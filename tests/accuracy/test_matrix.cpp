@@ -50,6 +50,7 @@ TEST(RegressionMatrix, NoFamilyAnswersWrongOrFewerRightThanItsFloor) {
   // same crops, the source's raster at another sub-cell phase (seed 31 refused).
   // kitti g0.2 3 -> 4: a thin feature answer confirmed over 2 slices (seed 16).
   // sunrgbd g0.05 4 -> 5: a clear winner on too few inliers checked wide (seed 31).
+  // sunrgbd g0.05 5 -> 8, g0.1 1 -> 2: sparse slices described, answers moved uphill.
   const std::map<std::string, int> floor = {{"demo-room g0.05", 2},
                                             {"indoor g0.05 x0.5", 10},
                                             {"indoor g0.1 x0.5", 10},
@@ -64,8 +65,8 @@ TEST(RegressionMatrix, NoFamilyAnswersWrongOrFewerRightThanItsFloor) {
                                             {"outdoor g0.5 x0.5", 10},
                                             {"room g0.05", 20},
                                             {"room g0.1", 20},
-                                            {"sunrgbd-room g0.05", 5},
-                                            {"sunrgbd-room g0.1", 1},
+                                            {"sunrgbd-room g0.05", 8},
+                                            {"sunrgbd-room g0.1", 2},
                                             {"nuscenes-lidar g0.2", 0},
                                             {"kitti-lidar g0.2", 4}};
   test::TempDir dir;

@@ -176,3 +176,19 @@ TEST(DenseSearch, ThePosesAroundAPoseShowWhetherTheOccupancyPinsItDown) {
   ASSERT_GT(at_rails.score(), 0);
   EXPECT_LT(significance(at_rails.score(), near_rails.score()), kSignificant);
 }
+
+// A pose a few cells and degrees off the right one, as a dense search's coarse
+// cell or a feature answer on a few keypoints leaves it, climbs back: the room
+// landed on itself is found again within a cell and a yaw step, landing more.
+TEST(DenseSearch, APoseOffTheRightOneClimbsUphillToIt) {
+  const SliceStack room = stackOf(roomScan());
+  DenseSearchParams two_threads;
+  two_threads.threads = 2;
+  const Rigid2D off{radians(4), {0.4, -0.3}};
+  const DensePose start = landPose(room, room, off, 1), top = uphill(room, room, off, 1, two_threads);
+  EXPECT_GT(top.score(), start.score());
+  EXPECT_EQ(top.offset, 0);
+  EXPECT_LT(top.transform.t.norm(), 1.5 * kGrid);
+  EXPECT_LT(std::abs(top.transform.yaw), radians(1));
+  EXPECT_GE(top.score(), landPose(room, room, Rigid2D{}, 0).score());
+}

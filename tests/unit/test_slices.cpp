@@ -75,6 +75,29 @@ TEST(Slices, SparseSlicesAreEmptiedAndEndsTrimmed) {
   EXPECT_EQ(s.size(), 26);  // the lone point's slice was trimmed away with the gap
 }
 
+// Two short rails above the room's ceiling: a third of the raster's width +
+// height in cells, a slice the stack keeps (kSparsestSlice) and its full
+// slices leave out (kFullSlice); the room's outline slices are in both, at
+// the same heights.
+TEST(Slices, ASparseSliceIsKeptButNotAmongTheFullSlices) {
+  Points pts = room(0.05);
+  for (double x = 0; x <= 1.2; x += 0.05) pts.emplace_back(x, 1.5, 3.4);
+  for (double x = 0; x <= 1.2; x += 0.05) pts.emplace_back(x, 1.7, 3.4);
+  const SliceStack s = makeSlices(pts, 0.1);
+  ASSERT_EQ(s.size(), 35);
+  const double outline = s.grid.width + s.grid.height;
+  EXPECT_GE(s.cells[34].size(), kSparsestSlice * outline);
+  EXPECT_LT(s.cells[34].size(), kFullSlice * outline);
+  EXPECT_TRUE(s.cells[30].empty());  // between: nothing
+  // Without it, the rails' slice and the empty ones below it are trimmed away,
+  // as slicing at that bar trims them.
+  const SliceStack full = fullSlices(s), at_full_bar = makeSlices(pts, 0.1, 0, nullptr, kFullSlice);
+  EXPECT_EQ(full.size(), 26);
+  EXPECT_EQ(full.grid, at_full_bar.grid);
+  EXPECT_EQ(full.cells, at_full_bar.cells);
+  EXPECT_EQ(full.cells[10], s.cells[10]);
+}
+
 TEST(Slices, TooFineGridFailsLoudly) {
   const Points pts{{0, 0, 0}, {1000, 1000, 1}};
   EXPECT_THROW(makeSlices(pts, 0.01), InputError);
