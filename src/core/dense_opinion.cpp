@@ -207,9 +207,11 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
   if (v.by == Verdict::By::at_grid) answer(r, *at_grid, *e.at_grid, target, source);
   if (v.by == Verdict::By::wide) answer(r, *wide, *e.wide, target, source);
   if (v.by == Verdict::By::pooled) answer(r, *at_pooled, *e.pooled, target, source);
-  // An answer the occupancy weighed is placed by it too; a clear feature winner
-  // (no dense evidence asked for) is placed by its thousands of keypoints.
-  if (r.reliable && (e.at_grid || e.wide)) climbUphill(r, target, source, params);
+  // An answer the occupancy weighed (a dense search found poses) is placed by
+  // it too; a clear feature winner, or one on a map too large to search, is
+  // placed by its keypoints.
+  const bool weighed = (e.at_grid && e.at_grid->found) || (e.wide && e.wide->found);
+  if (r.reliable && weighed) climbUphill(r, target, source, params);
   if (r.reliable) takeOccupancyHeight(r, target, source);
   r.timings.dense = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

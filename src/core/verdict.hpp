@@ -116,8 +116,8 @@ struct Verdict {
 };
 
 /// The verdict on `e`. A feature answer that leads its runner-up clearly
-/// (weakWinner) stands alone. One on fewer than min_support slice pairs (or a
-/// clear winner on fewer than min_inliers inliers) stands where the wide
+/// (weakWinner) stands alone. One the features refuse (fewer than min_support
+/// slice pairs, a runner-up within reach, fewer than min_inliers inliers) stands where the wide
 /// search's best pose lands on it and confirms it (kDenseOpinion, beyond
 /// chance, over kConfirmingSlices of the slices that land where the other map
 /// saw anything): the one of the two poses that lands more telling cells is

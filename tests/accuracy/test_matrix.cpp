@@ -51,6 +51,7 @@ TEST(RegressionMatrix, NoFamilyAnswersWrongOrFewerRightThanItsFloor) {
   // kitti g0.2 3 -> 4: a thin feature answer confirmed over 2 slices (seed 16).
   // sunrgbd g0.05 4 -> 5: a clear winner on too few inliers checked wide (seed 31).
   // sunrgbd g0.05 5 -> 8, g0.1 1 -> 2: sparse slices described, answers moved uphill.
+  // kitti g0.2 4 -> 5: an ambiguous winner checked wide (seed 16).
   const std::map<std::string, int> floor = {{"demo-room g0.05", 2},
                                             {"indoor g0.05 x0.5", 10},
                                             {"indoor g0.1 x0.5", 10},
@@ -68,7 +69,7 @@ TEST(RegressionMatrix, NoFamilyAnswersWrongOrFewerRightThanItsFloor) {
                                             {"sunrgbd-room g0.05", 8},
                                             {"sunrgbd-room g0.1", 2},
                                             {"nuscenes-lidar g0.2", 0},
-                                            {"kitti-lidar g0.2", 4}};
+                                            {"kitti-lidar g0.2", 5}};
   test::TempDir dir;
   // tomomap alone: the paper's method, which the suite runs beside it for
   // docs/results.md, answers wrong by design (it has no verdict).

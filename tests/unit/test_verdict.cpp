@@ -182,8 +182,12 @@ TEST(Verdict, TruthTable) {
   Evidence ambiguous_few = with(featureAnswer(6, 4));
   ambiguous_few.features.inliers = 10;
   ambiguous_few.wide.reset();
-  add("an ambiguous winner is not checked wide, however few its inliers", ambiguous_few, By::none,
-      Needs::search_at_grid);
+  add("an ambiguous winner is checked wide like a thin one (kitti-lidar-16: 3 vs 1)", ambiguous_few, By::none,
+      Needs::wide_search);
+  Evidence ambiguous_confirmed = with(featureAnswer(6, 4));
+  ambiguous_confirmed.wide = search(landed(1300), 1000, true, 0.2);
+  ambiguous_confirmed.features_landed = landed(1400);
+  add("... and answers where it confirms it", ambiguous_confirmed, By::features);
   add("no dense search possible (large map): a weak winner stands", with(featureAnswer(10, 2), DenseEvidence{}),
       By::features);
   add("no dense search possible, no feature answer: refused", with(none_found, DenseEvidence{}), By::none,
