@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <opencv2/imgproc.hpp>
 
 #include "dense_refine.hpp"
@@ -221,19 +222,27 @@ struct PoseJudge {
 
 }  // namespace
 
+PoseLander poseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params) {
+  if (target.partial || source.partial) return [](const auto&) { return std::vector<DensePose>{}; };
+  const auto judge = std::make_shared<const PoseJudge>(target, source, params);
+  const int threads = std::max(1, params.threads);
+  return [judge, threads](const std::vector<std::pair<Rigid2D, int>>& poses) {
+    std::vector<DensePose> out(poses.size());
+#pragma omp parallel for schedule(dynamic) num_threads(threads)
+    for (size_t n = 0; n < poses.size(); ++n) {
+      const auto& [T, offset] = poses[n];
+      DensePose& p = out[n];
+      p.transform = T, p.offset = offset;
+      judge->judge(p, judge->forth(landings(judge->source_cells, T, judge->target.grid), offset));
+    }
+    return out;
+  };
+}
+
 std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& source,
                                  const std::vector<std::pair<Rigid2D, int>>& poses, const DenseSearchParams& params) {
-  if (poses.empty() || target.partial || source.partial) return {};
-  const PoseJudge judge(target, source, params);
-  std::vector<DensePose> out(poses.size());
-#pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
-  for (size_t n = 0; n < poses.size(); ++n) {
-    const auto& [T, offset] = poses[n];
-    DensePose& p = out[n];
-    p.transform = T, p.offset = offset;
-    judge.judge(p, judge.forth(landings(judge.source_cells, T, target.grid), offset));
-  }
-  return out;
+  if (poses.empty()) return {};
+  return poseLander(target, source, params)(poses);
 }
 
 DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
@@ -277,7 +286,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   const int xt = (tg.width + c - 1) / c, yt = (tg.height + c - 1) / c, zt = (target.size() + c - 1) / c;
   // Source: turned about its raster's centre, so its coarse raster is a square
   // that holds it at any yaw.
-  const Eigen::Vector2d centre(sg.x_min + 0.5 * sg.width * sg.cell, sg.y_min + 0.5 * sg.height * sg.cell);
+  const Eigen::Vector2d centre = sg.centre();
   const double radius = 0.5 * sg.cell * std::hypot(sg.width, sg.height) + sg.cell;
   const int xs = static_cast<int>(std::ceil(2.0 * radius / C)) + 1, zs = (source.size() + c - 1) / c;
   const cv::Size padded(cv::getOptimalDFTSize(xt + xs - 1), cv::getOptimalDFTSize(yt + xs - 1));

@@ -1,6 +1,7 @@
 #pragma once
 // A dense search for small maps: every yaw, shift and height offset scored by
 // how much of the two maps' occupancy coincides, without features.
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -14,7 +15,7 @@ struct DenseSearchParams {
   /// The coarse raster has at most this many cells along each axis; the
   /// coarse cell is a whole number of grid cells (at most kMaxCoarsening).
   int coarse_side = 32;
-  int min_coarsening = 1;  ///< the coarse cell is at least this many grid cells (kWideCoarseSide)
+  int min_coarsening = 1;            ///< the coarse cell is at least this many grid cells (kWideCoarseSide)
   double yaw_step = radians(3.0);    ///< [rad]; 3 deg moves a point 3 m out by 0.16 m, under one coarse cell
   int candidates = 12;               ///< distinct coarse poses refined on the full grid
   double inlier_radius_cells = 1.5;  ///< [grid cells]
@@ -95,6 +96,12 @@ DensePose landPose(const SliceStack& target, const SliceStack& source, const Rig
 std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& source,
                                  const std::vector<std::pair<Rigid2D, int>>& poses,
                                  const DenseSearchParams& params = {});
+
+/// landPoses with the maps' occupancy prepared once for every call, for a
+/// caller that lands poses again and again (a climb, nearby_poses.hpp). The
+/// stacks must outlive it.
+using PoseLander = std::function<std::vector<DensePose>(const std::vector<std::pair<Rigid2D, int>>&)>;
+PoseLander poseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params = {});
 
 /// Correlates the maps' occupancy on a coarse raster at every yaw step, shift
 /// and height offset (FFT per slice pair), then refines the best distinct

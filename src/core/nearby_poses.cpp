@@ -39,20 +39,24 @@ std::vector<std::pair<Rigid2D, int>> stepsFrom(const DensePose& p, double cell, 
   return steps;
 }
 
-/// `p` moved one step at a time to the step that lands most, while it lands more.
-DensePose climb(const SliceStack& target, const SliceStack& source, DensePose p, const DenseSearchParams& params) {
-  const SliceGrid& sg = source.grid;
-  const Eigen::Vector2d centre(sg.x_min + 0.5 * sg.width * sg.cell, sg.y_min + 0.5 * sg.height * sg.cell);
-  const double yaw_step = 2.0 / std::hypot(sg.width, sg.height);
+/// `p` moved one step at a time to the step that lands most, while it lands
+/// more; `source` is the raster `land` lands the source's cells from.
+DensePose climb(const PoseLander& land, const SliceGrid& source, double cell, DensePose p) {
+  const double yaw_step = 2.0 / std::hypot(source.width, source.height);
   for (int step = 0; step < kMaxSteps; ++step) {
-    const std::vector<DensePose> landed =
-        landPoses(target, source, stepsFrom(p, target.grid.cell, yaw_step, centre), params);
+    const std::vector<DensePose> landed = land(stepsFrom(p, cell, yaw_step, source.centre()));
     if (landed.empty()) break;
     const DensePose next = best(landed);
     if (next.score() <= p.score()) break;
     p = next;
   }
   return p;
+}
+
+/// The pose (T, offset) landed; nothing landed (all counts 0) where `land` lands nothing.
+DensePose landed(const PoseLander& land, const Rigid2D& T, int offset) {
+  const std::vector<DensePose> one = land({{T, offset}});
+  return one.empty() ? DensePose{T, offset, 0} : one.front();
 }
 
 }  // namespace
@@ -73,18 +77,17 @@ DensePose bestAround(const SliceStack& target, const SliceStack& source, const R
   return best(landed);
 }
 
-}  // namespace tomomap
-
-namespace tomomap {
-
 DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                  const DenseSearchParams& params) {
-  DensePose top = climb(target, source, landPose(target, source, T, offset, params), params);
+  // One lander for the whole climb: every step lands its poses on the same prepared occupancy.
+  const PoseLander land = poseLander(target, source, params);
+  const double cell = target.grid.cell;
+  DensePose top = climb(land, source.grid, cell, landed(land, T, offset));
   DenseRefineParams refine;
   refine.threads = params.threads;
   for (int round = 0; round < kMaxRefinements; ++round) {
     const Rigid2D refined = refineOnOccupancy(target, source, top.offset, top.transform, refine).transform;
-    const DensePose next = climb(target, source, landPose(target, source, refined, top.offset, params), params);
+    const DensePose next = climb(land, source.grid, cell, landed(land, refined, top.offset));
     if (next.score() <= top.score()) break;
     top = next;
   }

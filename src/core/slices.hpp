@@ -33,6 +33,8 @@ struct SliceGrid {
   }
   /// The inverse: (sub)pixel position of map-frame x, y [m]; centres are integers.
   Eigen::Vector2d toPixel(double x, double y) const { return {(x - x_min) / cell - 0.5, (y - y_min) / cell - 0.5}; }
+  /// Map-frame x, y [m] of the raster's centre (what a search turns it about).
+  Eigen::Vector2d centre() const { return {x_min + 0.5 * width * cell, y_min + 0.5 * height * cell}; }
 };
 
 /// Occupied cells per slice, stored sparsely (pixel index v * width + u, sorted,
