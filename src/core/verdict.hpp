@@ -44,6 +44,12 @@ bool holdsOver(const DensePose& p, int min_support);
 /// counts (a negative score counts as none).
 double significance(double a, double b);
 
+/// How far apart two looks at one pose (two searches of the maps, or one
+/// with the maps' roles swapped) may place it and still be looks at one
+/// place [m]: two looks of equal spread lie sqrt(2) times one's error apart,
+/// so within sqrt(2) consensus tolerances, each is within the tolerance.
+double looksApart(const MatchParams& params, double grid);
+
 /// What the tomographic match found (matcher.cpp).
 struct FeatureEvidence {
   /// Why there is no feature answer at all (too few descriptive slices, no
@@ -64,6 +70,9 @@ struct DenseEvidence {
   double cell = 0;           ///< of the occupancy searched [m]
   bool at_features = false;  ///< its best pose is the features' answer (same place, within the smear of heights)
   double apart = 0, apart_yaw = 0, apart_height = 0;  ///< how far its best pose is from the features' [m, rad, m]
+  /// Its best pose is the best pose of the search at the map's grid (the same
+  /// place, within the smear of heights); asked of the pooled search alone.
+  bool at_grid_best = false;
 
   /// The best pose's score over its next's; 0 where even the best contradicts more than it finds.
   double lead() const;
@@ -132,7 +141,9 @@ struct Verdict {
 /// place of its own, and the features' answer then stands if its own landing
 /// holds. A match the features did not answer is answered by a clear dense
 /// pose. Where that leaves no answer and the pooled cell stays fine enough,
-/// the search on pooled occupancy answers with a clear pose of its own. Every
+/// the search on pooled occupancy answers with a clear pose of its own,
+/// unless the search at the map's grid puts a clear best pose elsewhere
+/// (one holding over too few slices to answer). Every
 /// lead must also be beyond chance (kSignificant) and its pose hold
 /// (kMostContradicted, min_support slices). The pose of a dense search that
 /// answers alone (at the map's grid or pooled) answers only where the same

@@ -255,6 +255,18 @@ TEST(Verdict, TruthTable) {
   Evidence pooled_clear = with(featureAnswer(1), search(landed(1200), 1000), 0.05);
   pooled_clear.pooled = search(landed(900), 300, false, 0.1);
   add("the pooled search answers with a clear pose of its own", pooled_clear, By::pooled);
+  // A grid pose 1.96x ahead over 1 slice: too few to answer, enough to outweigh a pooled pose elsewhere.
+  Evidence disputed = with(featureAnswer(1), search(landed(417, 0, 1), 213), 0.05);
+  disputed.pooled = search(landed(133), 82, false, 0.1);
+  add("... but not where the grid's best pose, holding over too few slices, leads 1.4x elsewhere "
+      "(sunrgbd-room-200: 1.36 m off)",
+      disputed, By::none, Needs::nothing,
+      "only 1 slice pairs agree (need 3); nor did a dense search of the occupancy find a clear pose (lead 1.96x; over "
+      "1 slices, need 3); at 0.10 m cells its best pose leads 1.62x but lies elsewhere than the map's grid's best "
+      "pose, 1.96x ahead over 1 slices");
+  Evidence undisputed = disputed;
+  undisputed.pooled->at_grid_best = true;
+  add("... and answers where that pose is its own", undisputed, By::pooled);
   Evidence agreeing = with(featureAnswer(1), search(landed(1250), 1000), 0.05);
   agreeing.pooled = search(landed(1150), 1000, false, 0.1);
   add("grid (1.25x) and pooled (1.15x) short of a clear pose refuse, on one pose or not", agreeing, By::none,
