@@ -135,6 +135,14 @@ std::string contradictionNote(const DenseEvidence& d) {
          fixed(100 * kMostContradicted, 0) + " %)";
 }
 
+/// How a pose found otherwise measures against outscoring a pose that scores
+/// `other` by `by` (outscores): its lead, and each bar it falls short of.
+std::string outscoring(const DensePose& p, double other, double by, const MatchParams& params) {
+  DenseEvidence d;
+  d.found = true, d.best = p, d.next_score = other;
+  return shortfall(d, by, p.support_seen, params.min_support) + contradictionNote(d);
+}
+
 /// How far a search's best pose lies from the features' answer, as a refusal says it.
 std::string howFarApart(const DenseEvidence& d) {
   return fixed(d.apart, 2) + " m, " + fixed(degrees(d.apart_yaw), 1) + " deg and " + fixed(d.apart_height, 2) +
@@ -241,6 +249,10 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
                fixed((near.transform.t - landed.transform.t).norm(), 2) + " m from it " + fixed(near.score(), 0) +
                " (" + fixed(significance(landed.score(), near.score()), 1) + " sigma beyond chance, need " +
                fixed(kSignificant, 0) + "): the occupancy does not pin it down";
+      } else {
+        why += "; the features' pose lands " + fixed(landed.score(), 0) + " telling cells, that pose " +
+               fixed(e.wide->best.score(), 0) + " (" + outscoring(landed, e.wide->best.score(), kDenseLead, params) +
+               ")";
       }
     }
   }

@@ -161,9 +161,11 @@ TEST(Verdict, TruthTable) {
       "only 1 slice pairs agree (need 3); a search on a raster twice as fine did not confirm it (lead 1.30x; 2.0 "
       "sigma beyond chance, need 3)");
   elsewhere.at_grid = DenseEvidence{};
-  add("... or where its best pose lies", elsewhere, By::none, Needs::nothing,
+  add("... or where its best pose lies, and how the features' own pose landed against it", elsewhere, By::none,
+      Needs::nothing,
       "only 1 slice pairs agree (need 3); a search on a raster twice as fine did not confirm it (its best pose lies "
-      "2.50 m, 0.0 deg and 0.00 m in height away)");
+      "2.50 m, 0.0 deg and 0.00 m in height away); the features' pose lands 1000 telling cells, that pose 1300 (lead "
+      "0.77x, need 1.40x; -6.3 sigma beyond chance, need 3)");
   add("a weak winner: the dense search is asked", with(featureAnswer(10, 2)), By::none, Needs::search_at_grid);
   add("two answers within min_support pairs are ambiguous", with(featureAnswer(6, 4), DenseEvidence{}, 0.2), By::none,
       Needs::nothing, "ambiguous: another answer 12");
