@@ -145,12 +145,14 @@ void climbUphill(MatchResult& r, const std::vector<std::pair<Rigid2D, int>>& fou
     if (std::abs(offset - r.height_offset) <= kSmearSlices / 2 &&
         agree(T, answer, same, source.occupancy.grid.centre()))
       starts.emplace_back(T, offset);
-  const std::vector<DensePose> landed = landPoses(target.occupancy, source.occupancy, starts, dp);
+  // One preparation of the occupancy lands the starts and serves the climb.
+  const PoseLander land = poseLander(target.occupancy, source.occupancy, dp);
+  const std::vector<DensePose> landed = land(starts);
   if (landed.empty()) return;
   const DensePose* start = &landed.front();
   for (const DensePose& p : landed)
     if (p.score() > start->score() && significance(p.score(), landed.front().score()) >= kSignificant) start = &p;
-  const DensePose top = uphill(target.occupancy, source.occupancy, start->transform, start->offset, dp);
+  const DensePose top = uphill(land, target.occupancy, source.occupancy, start->transform, start->offset, dp);
   r.T_target_source = {top.transform.t.x(), top.transform.t.y(), heightShift(target, source, top.offset),
                        wrapAngle(top.transform.yaw)};
   r.height_offset = top.offset;

@@ -245,10 +245,14 @@ std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& sou
   return poseLander(target, source, params)(poses);
 }
 
+DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset) {
+  const std::vector<DensePose> landed = land({{T, offset}});
+  return landed.empty() ? DensePose{T, offset, 0} : landed.front();
+}
+
 DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                    const DenseSearchParams& params) {
-  const std::vector<DensePose> landed = landPoses(target, source, {{T, offset}}, params);
-  return landed.empty() ? DensePose{T, offset, 0} : landed.front();
+  return landPose(poseLander(target, source, params), T, offset);
 }
 
 int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,

@@ -103,6 +103,10 @@ std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& sou
 using PoseLander = std::function<std::vector<DensePose>(const std::vector<std::pair<Rigid2D, int>>&)>;
 PoseLander poseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params = {});
 
+/// landPose with a lander: (T, offset) landed, nothing landed (all counts 0)
+/// where `land` lands nothing.
+DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset);
+
 /// Correlates the maps' occupancy on a coarse raster at every yaw step, shift
 /// and height offset (FFT per slice pair), then refines the best distinct
 /// coarse poses on the full grid (refineOnOccupancy) and counts their inliers.

@@ -53,12 +53,6 @@ DensePose climb(const PoseLander& land, const SliceGrid& source, double cell, De
   return p;
 }
 
-/// The pose (T, offset) landed; nothing landed (all counts 0) where `land` lands nothing.
-DensePose landed(const PoseLander& land, const Rigid2D& T, int offset) {
-  const std::vector<DensePose> one = land({{T, offset}});
-  return one.empty() ? DensePose{T, offset, 0} : one.front();
-}
-
 }  // namespace
 
 DensePose bestAround(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset, int inner_cells,
@@ -79,15 +73,18 @@ DensePose bestAround(const SliceStack& target, const SliceStack& source, const R
 
 DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                  const DenseSearchParams& params) {
-  // One lander for the whole climb: every step lands its poses on the same prepared occupancy.
-  const PoseLander land = poseLander(target, source, params);
+  return uphill(poseLander(target, source, params), target, source, T, offset, params);
+}
+
+DensePose uphill(const PoseLander& land, const SliceStack& target, const SliceStack& source, const Rigid2D& T,
+                 int offset, const DenseSearchParams& params) {
   const double cell = target.grid.cell;
-  DensePose top = climb(land, source.grid, cell, landed(land, T, offset));
+  DensePose top = climb(land, source.grid, cell, landPose(land, T, offset));
   DenseRefineParams refine;
   refine.threads = params.threads;
   for (int round = 0; round < kMaxRefinements; ++round) {
     const Rigid2D refined = refineOnOccupancy(target, source, top.offset, top.transform, refine).transform;
-    const DensePose next = climb(land, source.grid, cell, landed(land, refined, top.offset));
+    const DensePose next = climb(land, source.grid, cell, landPose(land, refined, top.offset));
     if (next.score() <= top.score()) break;
     top = next;
   }

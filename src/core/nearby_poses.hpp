@@ -28,5 +28,9 @@ DensePose bestAround(const SliceStack& target, const SliceStack& source, const R
 /// (T, offset) itself, landed, where nothing uphill lands more or either stack is partial.
 DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                  const DenseSearchParams& params = {});
+/// uphill with `land`, a lander of `target` and `source` (dense_search.hpp)
+/// the caller has prepared already: one preparation serves every step.
+DensePose uphill(const PoseLander& land, const SliceStack& target, const SliceStack& source, const Rigid2D& T,
+                 int offset, const DenseSearchParams& params = {});
 
 }  // namespace tomomap
