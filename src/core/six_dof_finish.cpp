@@ -1,0 +1,431 @@
+#include "six_dof_finish.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <sstream>
+
+namespace tomomap {
+namespace {
+
+/// A cell's place on its raster's lattice: column u, row v, slice k.
+struct LatticeCell {
+  int u = 0, v = 0, k = 0;
+};
+
+/// The occupied cells of a stack in slice order, thinned to every `stride`-th.
+std::vector<LatticeCell> latticeCells(const SliceStack& s, size_t stride = 1) {
+  std::vector<LatticeCell> out;
+  const auto w = static_cast<uint32_t>(s.grid.width);
+  size_t n = 0;
+  for (int k = 0; k < s.size(); ++k)
+    for (uint32_t index : s.cells[static_cast<size_t>(k)])
+      if (n++ % stride == 0) out.push_back({static_cast<int>(index % w), static_cast<int>(index / w), k});
+  return out;
+}
+
+size_t cellCount(const SliceStack& s) {
+  size_t n = 0;
+  for (const auto& c : s.cells) n += c.size();
+  return n;
+}
+
+/// The map-frame centre [m] of a lattice cell (slices.hpp's conventions).
+Eigen::Vector3d centreOf(const SliceGrid& g, const LatticeCell& c) {
+  return {g.x_min + (c.u + 0.5) * g.cell, g.y_min + (c.v + 0.5) * g.cell, g.sliceHeight(c.k)};
+}
+
+/// The inverse: (sub)cell lattice position of a map-frame point; centres are integers.
+Eigen::Vector3d latticeOf(const SliceGrid& g, const Eigen::Vector3d& p) {
+  return {(p.x() - g.x_min) / g.cell - 0.5, (p.y() - g.y_min) / g.cell - 0.5, (p.z() - g.z_min) / g.cell};
+}
+
+/// Open-addressing hash of the occupied lattice cells (key -> cell index). The
+/// cells lie on a lattice, so a neighbour lookup is a probe of its key: no
+/// kd-tree. Linear probing in a table at most half full costs one or two
+/// probes, a few times cheaper than std::unordered_map's buckets.
+class LatticeIndex {
+ public:
+  LatticeIndex(const SliceGrid& g, int slices, const std::vector<LatticeCell>& cells)
+      : width_(g.width), height_(g.height), slices_(slices) {
+    size_t capacity = 16;
+    while (capacity < 2 * cells.size()) capacity *= 2;
+    mask_ = capacity - 1;
+    keys_.assign(capacity, kEmpty);
+    values_.resize(capacity);
+    for (size_t i = 0; i < cells.size(); ++i) {
+      const uint64_t key = keyOf(cells[i].u, cells[i].v, cells[i].k);
+      size_t s = slotOf(key);
+      while (keys_[s] != kEmpty && keys_[s] != key) s = (s + 1) & mask_;
+      if (keys_[s] == key) continue;  // the first of equal keys stands
+      keys_[s] = key;
+      values_[s] = static_cast<uint32_t>(i);
+    }
+  }
+  /// Index of the occupied cell at (u, v, k), or -1.
+  int64_t find(int u, int v, int k) const {
+    if (u < 0 || v < 0 || k < 0 || u >= width_ || v >= height_ || k >= slices_) return -1;
+    const uint64_t key = keyOf(u, v, k);
+    for (size_t s = slotOf(key);; s = (s + 1) & mask_) {
+      if (keys_[s] == key) return values_[s];
+      if (keys_[s] == kEmpty) return -1;
+    }
+  }
+
+ private:
+  static constexpr uint64_t kEmpty = ~uint64_t{0};
+  uint64_t keyOf(int u, int v, int k) const {
+    return (static_cast<uint64_t>(k) * static_cast<uint64_t>(height_) + static_cast<uint64_t>(v)) *
+               static_cast<uint64_t>(width_) +
+           static_cast<uint64_t>(u);
+  }
+  size_t slotOf(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_; }
+  int width_, height_, slices_;
+  size_t mask_ = 0;
+  std::vector<uint64_t> keys_;
+  std::vector<uint32_t> values_;
+};
+
+/// A lattice step to a neighbour, and its length [cells].
+struct Offset {
+  int du, dv, dk;
+  double length;
+};
+
+/// Every lattice step up to `radius` cells long, shortest first (ties in a fixed
+/// order): a search walks them outward and stops once no step can come nearer.
+std::vector<Offset> offsetsWithin(double radius) {
+  const int r = static_cast<int>(std::ceil(radius));
+  std::vector<Offset> out;
+  for (int dk = -r; dk <= r; ++dk)
+    for (int dv = -r; dv <= r; ++dv)
+      for (int du = -r; du <= r; ++du) {
+        const double length = std::sqrt(static_cast<double>(du * du + dv * dv + dk * dk));
+        if (length <= radius) out.push_back({du, dv, dk, length});
+      }
+  std::stable_sort(out.begin(), out.end(), [](const Offset& a, const Offset& b) { return a.length < b.length; });
+  return out;
+}
+
+/// A target cell's surface: the plane through its neighbourhood's mean.
+struct Plane {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();   ///< [m]
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit; zero where the neighbourhood is not a plane
+};
+
+/// The target's cells, indexed, each with its plane.
+struct Target {
+  SliceGrid grid;
+  int slices = 0;
+  std::vector<LatticeCell> cells;
+  LatticeIndex index;
+  std::vector<Plane> planes;
+  LatticeIndex columns;  ///< (u, v) of every column with a cell in some slice: where the target saw anything
+  std::vector<Offset>
+      search;  ///< steps out to the widest radius, plus the half diagonal a position may sit off its cell
+};
+
+/// Fewer cells than this within the normal radius do not fit a plane (a plane
+/// crossing the radius-2 ball holds about 13).
+constexpr int kMinPlaneCells = 6;
+
+std::vector<Plane> fitPlanes(const Target& t, double radius_cells, double planarity, int threads) {
+  const std::vector<Offset> near = offsetsWithin(radius_cells);
+  std::vector<Plane> planes(t.cells.size());
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (size_t i = 0; i < t.cells.size(); ++i) {
+    const LatticeCell& c = t.cells[i];
+    // In lattice units (the cells are cubes): the offsets are exact integers.
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+    int n = 0;
+    for (const Offset& o : near) {
+      if (t.index.find(c.u + o.du, c.v + o.dv, c.k + o.dk) < 0) continue;
+      const Eigen::Vector3d d(o.du, o.dv, o.dk);
+      sum += d;
+      outer += d * d.transpose();
+      ++n;
+    }
+    if (n < kMinPlaneCells) continue;
+    const Eigen::Vector3d mean = sum / n;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(outer / n - mean * mean.transpose());
+    const Eigen::Vector3d l = eig.eigenvalues();  // ascending
+    if (!(l(0) <= planarity * l(1))) continue;    // a corner, an edge, clutter: no one normal
+    planes[i].point = centreOf(t.grid, c) + t.grid.cell * mean;
+    planes[i].normal = eig.eigenvectors().col(0).normalized();
+  }
+  return planes;
+}
+
+/// The occupied target cell nearest to lattice position f within `radius`
+/// cells, or -1: the steps are walked outward from f's cell until none can
+/// come nearer than the nearest found (a step of length L lands at least
+/// L - |f - its cell| from f).
+int64_t nearestCell(const Target& t, const Eigen::Vector3d& f, double radius) {
+  const double reach = radius + 1.0;  // farther out nothing is in reach, and rounding f could overflow
+  if (!(f.x() > -reach && f.y() > -reach && f.z() > -reach && f.x() < t.grid.width + reach &&
+        f.y() < t.grid.height + reach && f.z() < t.slices + reach))
+    return -1;
+  const int u = static_cast<int>(std::lround(f.x())), v = static_cast<int>(std::lround(f.y())),
+            k = static_cast<int>(std::lround(f.z()));
+  const Eigen::Vector3d off = f - Eigen::Vector3d(u, v, k);
+  const double slack = off.norm();
+  double best = radius;
+  int64_t found = -1;
+  for (const Offset& o : t.search) {
+    if (o.length - slack > best) break;
+    const int64_t i = t.index.find(u + o.du, v + o.dv, k + o.dk);
+    if (i < 0) continue;
+    const double d = (Eigen::Vector3d(o.du, o.dv, o.dk) - off).norm();
+    if (d < best || (found < 0 && d <= best)) {
+      best = d;
+      found = i;
+    }
+  }
+  return found;
+}
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+/// One sweep's sums over its source cells: the robust normal equations of the
+/// point-to-plane residuals and the unweighted inliers' statistics.
+struct Sweep {
+  Matrix6d H = Matrix6d::Zero();
+  Vector6d g = Vector6d::Zero();
+  double weights = 0;
+  size_t inliers = 0;
+  double squares = 0;  ///< sum of the inliers' squared residuals [m^2]
+  size_t seen = 0;     ///< cells landing in a column where the target saw anything
+  size_t seen_inliers = 0;
+  void add(const Sweep& o) {
+    H += o.H;
+    g += o.g;
+    weights += o.weights;
+    inliers += o.inliers;
+    squares += o.squares;
+    seen += o.seen;
+    seen_inliers += o.seen_inliers;
+  }
+  /// The share of the cells in the target's columns that found their surface.
+  double seenShare() const { return seen == 0 ? 0.0 : static_cast<double>(seen_inliers) / static_cast<double>(seen); }
+  double rms() const { return inliers == 0 ? 0.0 : std::sqrt(squares / static_cast<double>(inliers)); }
+};
+
+/// The source cells in a fixed number of chunks, summed in chunk order: the
+/// same sums, bit for bit, on any number of threads.
+constexpr size_t kChunks = 64;
+
+/// The source cells' fit at T (p_target = T * p_source) against the target's
+/// planes, correspondences within `radius` cells. The unknowns are a turn about
+/// `pivot` (the source cells' centroid in the target frame, scaled by `lever`,
+/// their rms distance from it, so that all six are in metres and the system is
+/// well conditioned far from the origin) and a shift.
+Sweep sweep(const Target& t, const std::vector<Eigen::Vector3d>& source, const Eigen::Matrix4d& T, double radius,
+            double kernel, const Eigen::Vector3d& pivot, double lever, int threads) {
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  const Eigen::Vector3d shift = T.topRightCorner<3, 1>();
+  const double kernel2 = kernel * kernel;
+  std::vector<Sweep> chunks(kChunks);
+  const size_t per_chunk = (source.size() + kChunks - 1) / kChunks;
+#pragma omp parallel for schedule(dynamic) num_threads(threads)
+  for (size_t c = 0; c < kChunks; ++c) {
+    Sweep& s = chunks[c];
+    for (size_t i = c * per_chunk; i < std::min(source.size(), (c + 1) * per_chunk); ++i) {
+      const Eigen::Vector3d p = R * source[i] + shift;
+      const Eigen::Vector3d f = latticeOf(t.grid, p);
+      const bool seen =
+          std::abs(f.x()) < 1e9 && std::abs(f.y()) < 1e9 &&
+          t.columns.find(static_cast<int>(std::lround(f.x())), static_cast<int>(std::lround(f.y())), 0) >= 0;
+      s.seen += seen;
+      const int64_t j = nearestCell(t, f, radius);
+      if (j < 0) continue;
+      const Plane& plane = t.planes[static_cast<size_t>(j)];
+      if (plane.normal.isZero()) continue;
+      s.seen_inliers += seen;
+      const double r = plane.normal.dot(p - plane.point);
+      // Geman-McClure: a cell off its plane by the kernel scale pulls a quarter
+      // as hard, one off by the radius a hundredth (kernel = radius / 3).
+      const double w = kernel2 * kernel2 / ((kernel2 + r * r) * (kernel2 + r * r));
+      Vector6d J;
+      J.head<3>() = (p - pivot).cross(plane.normal) / lever;
+      J.tail<3>() = plane.normal;
+      s.H += w * J * J.transpose();
+      s.g += w * r * J;
+      s.weights += w;
+      ++s.inliers;
+      s.squares += r * r;
+    }
+  }
+  Sweep total;
+  for (const Sweep& s : chunks) total.add(s);
+  return total;
+}
+
+/// The rotation of a rotation vector [rad].
+Eigen::Matrix3d rotationOf(const Eigen::Vector3d& w) {
+  const double angle = w.norm();
+  if (angle < 1e-15) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
+}
+
+double turnBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return Eigen::AngleAxisd(a.transpose() * b).angle();
+}
+
+std::string figure(double v, int precision = 2) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(precision);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+SixDofFinish finishSixDof(const SliceStack& target, const SliceStack& source, const Eigen::Matrix4d& T_start,
+                          const SixDofFinishParams& params) {
+  SixDofFinish result;
+  result.T_target_source = T_start;
+  const size_t target_cells = cellCount(target), source_cells = cellCount(source);
+  if (target_cells == 0 || source_cells == 0 || params.radii_cells.empty() || params.max_points == 0) {
+    result.why_not = "too little overlap: " + std::to_string(target_cells) + " target and " +
+                     std::to_string(source_cells) + " source cells";
+    return result;
+  }
+  const double cell = target.grid.cell;
+  const double last_radius = params.radii_cells.back();
+  const double widest = *std::max_element(params.radii_cells.begin(), params.radii_cells.end());
+
+  // The source cells, evenly thinned, in the source frame [m].
+  const size_t stride = std::max<size_t>(1, (source_cells + params.max_points - 1) / params.max_points);
+  std::vector<Eigen::Vector3d> points;
+  for (const LatticeCell& c : latticeCells(source, stride)) points.push_back(centreOf(source.grid, c));
+  result.points = points.size();
+
+  std::vector<LatticeCell> cells = latticeCells(target);
+  std::vector<LatticeCell> columns;
+  for (const LatticeCell& c : cells) columns.push_back({c.u, c.v, 0});
+  Target t{target.grid,
+           target.size(),
+           cells,
+           LatticeIndex(target.grid, target.size(), cells),
+           {},
+           LatticeIndex(target.grid, 1, columns),
+           offsetsWithin(widest + std::sqrt(3.0) / 2)};
+  t.planes = fitPlanes(t, params.normal_radius_cells, params.planarity, params.threads);
+
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : points) centroid += p;
+  centroid /= static_cast<double>(points.size());
+  double spread = 0;
+  for (const auto& p : points) spread += (p - centroid).squaredNorm();
+  const double lever = std::max(cell, std::sqrt(spread / static_cast<double>(points.size())));
+
+  const auto judge = [&](const Eigen::Matrix4d& T) {
+    const Eigen::Vector3d pivot = T.topLeftCorner<3, 3>() * centroid + T.topRightCorner<3, 1>();
+    return sweep(t, points, T, last_radius, params.kernel_share * last_radius * cell, pivot, lever, params.threads);
+  };
+  const Sweep before = judge(T_start);
+  result.inliers_before = before.inliers;
+  result.rms_before = before.rms();
+  result.seen_found_before = before.seenShare();
+  const auto share = [&](size_t n) {
+    return figure(100.0 * static_cast<double>(n) / static_cast<double>(points.size()), 1) + " %";
+  };
+  const double least = params.min_overlap * static_cast<double>(points.size());
+  if (static_cast<double>(before.inliers) < least) {
+    result.why_not = "too little overlap at the start: " + std::to_string(before.inliers) + " of " +
+                     std::to_string(points.size()) + " cells (" + share(before.inliers) + ") within " +
+                     figure(last_radius, 1) + " cells of a target plane, need " + figure(100 * params.min_overlap, 0) +
+                     " %";
+    return result;
+  }
+
+  // Gauss-Newton, stage by stage, each from the last one's answer. A small
+  // damping keeps directions no surface fixes (a corridor's length) where they
+  // are; it vanishes with the step, so it does not bias the answer.
+  constexpr double kDamping = 1e-3;
+  Eigen::Matrix4d T = T_start;
+  double last_step = 0;
+  bool converged = false;
+  for (double radius : params.radii_cells) {
+    converged = false;
+    for (int it = 0; it < params.iterations_per_stage && !converged; ++it) {
+      const Eigen::Vector3d pivot = T.topLeftCorner<3, 3>() * centroid + T.topRightCorner<3, 1>();
+      const Sweep s = sweep(t, points, T, radius, params.kernel_share * radius * cell, pivot, lever, params.threads);
+      ++result.iterations;
+      if (s.inliers < 6) {
+        result.why_not = "diverged: " + std::to_string(s.inliers) + " cells within " + figure(radius, 1) +
+                         " cells of a target plane";
+        return result;
+      }
+      const Vector6d x = -(s.H + kDamping * s.weights * Matrix6d::Identity()).ldlt().solve(s.g);
+      if (!x.allFinite()) {
+        result.why_not = "diverged: the 6x6 system has no solution";
+        return result;
+      }
+      const Eigen::Matrix3d dR = rotationOf(x.head<3>() / lever);
+      Eigen::Matrix4d step = Eigen::Matrix4d::Identity();
+      step.topLeftCorner<3, 3>() = dR;
+      step.topRightCorner<3, 1>() = pivot - dR * pivot + x.tail<3>();
+      T = step * T;
+      // x is in metres at the cells' rms distance: how far the step moved them.
+      last_step = x.norm();
+      converged = last_step < params.converged_cells * cell;
+    }
+  }
+
+  const Eigen::Matrix3d R0 = T_start.topLeftCorner<3, 3>(), R = T.topLeftCorner<3, 3>();
+  result.roll_pitch_corrected =
+      std::acos(std::clamp((R * Eigen::Vector3d::UnitZ()).dot(R0 * Eigen::Vector3d::UnitZ()), -1.0, 1.0));
+  double moved = 0;
+  for (const auto& p : points) moved += ((T - T_start) * p.homogeneous()).norm();
+  result.moved = moved / static_cast<double>(points.size());
+  const double turned = turnBetween(R0, R);
+  if (!converged && last_step > 0.1 * cell) {
+    result.why_not = "diverged: still moving the cells " + figure(last_step / cell) + " cells an iteration after " +
+                     std::to_string(result.iterations) + " iterations";
+    return result;
+  }
+  if (result.moved > params.max_move_cells * cell || turned > params.max_turn) {
+    result.why_not = "diverged: it moved the cells " + figure(result.moved) + " m on average and turned " +
+                     figure(degrees(turned)) + " deg; a finish moves at most " + figure(params.max_move_cells * cell) +
+                     " m and turns " + figure(degrees(params.max_turn)) + " deg";
+    return result;
+  }
+  const Sweep after = judge(T);
+  result.inliers_after = after.inliers;
+  result.rms_after = after.rms();
+  result.seen_found_after = after.seenShare();
+  // More cells on their surfaces may well raise the rms a little (a start a few
+  // cells off holds mostly the floor, whose cells lie flat): only a fall in
+  // inliers or an rms beyond what aligned cells show refuses the result.
+  if (after.inliers < before.inliers) {
+    result.why_not = "the overlap got worse: " + std::to_string(before.inliers) + " -> " +
+                     std::to_string(after.inliers) + " cells within " + figure(last_radius, 1) +
+                     " cells of a target plane";
+    return result;
+  }
+  if (result.seen_found_after < params.min_seen_found) {
+    result.why_not = "too little overlap: " + figure(100 * result.seen_found_after, 0) +
+                     " % of the cells landing where the target saw anything lie on its surfaces, need " +
+                     figure(100 * params.min_seen_found, 0) + " %";
+    return result;
+  }
+  if (result.rms_after > params.max_rms_cells * cell) {
+    result.why_not = "residual grew: the inliers' rms " + figure(result.rms_before / cell) + " -> " +
+                     figure(result.rms_after / cell) + " cells, aligned cells show at most " +
+                     figure(params.max_rms_cells) + " (" + share(after.inliers) + " of the cells within " +
+                     figure(last_radius, 1) + " cells)";
+    return result;
+  }
+  result.held = true;
+  result.T_target_source = T;
+  return result;
+}
+
+}  // namespace tomomap
