@@ -120,12 +120,19 @@ struct Target {
   SliceGrid grid;
   int slices = 0;
   std::vector<LatticeCell> cells;
-  LatticeIndex index;
-  std::vector<Plane> planes;
+  LatticeIndex index;    ///< of `cells`
   LatticeIndex columns;  ///< (u, v) of every column with a cell in some slice: where the target saw anything
-  std::vector<Offset>
-      search;  ///< steps out to the widest radius, plus the half diagonal a position may sit off its cell
+  /// Steps out to the widest radius plus the half diagonal a position may sit off its cell.
+  std::vector<Offset> search;
+  std::vector<Plane> planes;  ///< one per cell
 };
+
+std::vector<LatticeCell> columnsOf(const std::vector<LatticeCell>& cells) {
+  std::vector<LatticeCell> out;
+  out.reserve(cells.size());
+  for (const LatticeCell& c : cells) out.push_back({c.u, c.v, 0});
+  return out;
+}
 
 /// Fewer cells than this within the normal radius do not fit a plane (a plane
 /// crossing the radius-2 ball holds about 13).
@@ -306,16 +313,14 @@ SixDofFinish finishSixDof(const SliceStack& target, const SliceStack& source, co
   for (const LatticeCell& c : latticeCells(source, stride)) points.push_back(centreOf(source.grid, c));
   result.points = points.size();
 
-  std::vector<LatticeCell> cells = latticeCells(target);
-  std::vector<LatticeCell> columns;
-  for (const LatticeCell& c : cells) columns.push_back({c.u, c.v, 0});
+  const std::vector<LatticeCell> cells = latticeCells(target);
   Target t{target.grid,
            target.size(),
            cells,
            LatticeIndex(target.grid, target.size(), cells),
-           {},
-           LatticeIndex(target.grid, 1, columns),
-           offsetsWithin(widest + std::sqrt(3.0) / 2)};
+           LatticeIndex(target.grid, 1, columnsOf(cells)),
+           offsetsWithin(widest + std::sqrt(3.0) / 2),
+           {}};
   t.planes = fitPlanes(t, params.normal_radius_cells, params.planarity, params.threads);
 
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();

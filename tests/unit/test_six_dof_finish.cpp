@@ -258,6 +258,20 @@ TEST(SixDofFinish, RefusesAnUnrelatedScene) {
   EXPECT_EQ(f.T_target_source, start);
 }
 
+// The same good start, with a finish allowed to move the cells one cell at
+// most: the 0.35 m it needs is past that, so it keeps the start and says why.
+TEST(SixDofFinish, KeepsTheStartWhereTheFinishWouldMoveTooFar) {
+  const Scene& s = rooms();
+  SixDofFinishParams tight;
+  tight.max_move_cells = 1.0;
+  const Eigen::Matrix4d start = fourDofStart(kTruth);
+  const SixDofFinish f = finishSixDof(s.target, s.source, start, tight);
+  EXPECT_FALSE(f.held);
+  EXPECT_NE(f.why_not.find("moved the cells"), std::string::npos) << f.why_not;
+  EXPECT_GT(f.moved, 2 * kGrid);
+  EXPECT_EQ(f.T_target_source, start);
+}
+
 TEST(SixDofFinish, GivesTheSameAnswerOnOneThreadOrTwo) {
   const Scene& s = rooms();
   SixDofFinishParams serial, threaded;
