@@ -28,6 +28,8 @@ inline std::string demoRoom() { return TOMOMAP_DEMO_ROOM; }
 inline bool haveDemoRoom() { return std::filesystem::exists(demoRoom() + "/demo-pcd1.pcd"); }
 /// The real sensor scans beside demo-room (../shared/data/real-scans).
 inline std::string realScans() { return demoRoom() + "/../real-scans"; }
+/// The posed SLAM sequences beside them (../shared/data/slam-sequences).
+inline std::string slamSequences() { return demoRoom() + "/../slam-sequences"; }
 
 #define REQUIRE_DEMO_ROOM()             \
   if (!::tomomap::test::haveDemoRoom()) \

@@ -45,17 +45,17 @@ int main(int argc, char** argv) {
       ->check(settingRange("threads"));
   return parseAndRun(app, argc, argv, [&] {
     requireBothOrNeither(gt_target, gt_source);
-    std::optional<Eigen::Matrix4d> P_target, P_source;
-    if (!gt_target.empty()) P_target = loadPoseFile(gt_target);
-    if (!gt_source.empty()) P_source = loadPoseFile(gt_source);
+    std::optional<GroundTruth> truth;
+    if (!gt_target.empty()) truth = GroundTruth{loadPoseFile(gt_target), loadPoseFile(gt_source), {}};
     const Points t = loadMap(target), s = loadMap(source);
+    if (truth) truth->source_sample = sourceSample(s);
     const nlohmann::json sizes = {
         {"target", target}, {"source", source}, {"target_points", t.size()}, {"source_points", s.size()}};
     if (method == "paper-consensus") {
       MatchParams params;
       params.grid = p.grid;
       params.threads = p.threads;
-      return report(baseline::matchPaperConsensus(t, s, params), P_target, P_source, p.grid, {json, method, false},
+      return report(baseline::matchPaperConsensus(t, s, params), truth, p.grid, {json, method, false},
                     sizes);
     }
     const baseline::FpfhResult b = baseline::matchFpfhRansac(t, s, p);
@@ -68,6 +68,6 @@ int main(int argc, char** argv) {
     r.source_features = b.source_keypoints;
     r.timings.features = b.describe_seconds;
     r.timings.pair_matching = b.ransac_seconds;
-    return report(r, P_target, P_source, p.grid, {json, method, false}, sizes);
+    return report(r, truth, p.grid, {json, method, false}, sizes);
   });
 }

@@ -10,6 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <tuple>
 
 #include "child_process.hpp"
 #include "commands.hpp"
@@ -17,6 +18,7 @@
 #include "exit_codes.hpp"
 #include "grid_option.hpp"
 #include "io/map_io.hpp"
+#include "io/pose_sequence.hpp"
 #include "results/json_schema.hpp"
 #include "suite.hpp"
 #include "synth_files.hpp"
@@ -36,7 +38,7 @@ struct Row {
   std::string pair, noise, family, method;
   int exit_code = -1;
   bool reliable = false, success = false;
-  double grid = 0, translation_error = NAN, yaw_error = NAN, seconds = 0, cpu_seconds = 0, peak_rss_mb = 0;
+  double grid = 0, translation_error = NAN, origin_error = NAN, yaw_error = NAN, seconds = 0, cpu_seconds = 0, peak_rss_mb = 0;
   double features = 0, slices = 0, payload_bytes = 0, raw_bytes = 0;
   std::string note;
 };
@@ -97,6 +99,7 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   row.reliable = j.value("reliable", false);
   if (j.contains("error")) {
     row.translation_error = j["error"]["translation"];
+    row.origin_error = j["error"].value("translation_at_origin", NAN);
     row.yaw_error = j["error"]["yaw"];
     row.success = j["error"]["success"];
   }
@@ -199,13 +202,31 @@ cv::Mat boxPlots(const std::vector<Row>& rows, const std::vector<std::string>& m
 
 struct EvalOptions {
   std::string suite, out = "eval-out";
+  SuiteSequence sequence;  ///< a user's own posed sequence, instead of a suite (--scans, --poses)
+  int sequence_pairs = 10;
   std::vector<std::string> methods;
   int threads = 0;
   double timeout_s = 0;  ///< per run; 0 = none
 };
 
+/// The suite a user's own posed sequence stands for: `pairs` seeds of it, tomomap alone.
+Suite sequenceSuite(SuiteSequence q, int pairs) {
+  Suite s;
+  if (q.name.empty()) q.name = fs::path(q.scans).lexically_normal().parent_path().filename().string();
+  if (q.name.empty()) q.name = "sequence";
+  s.name = q.name;
+  s.methods = {"tomomap"};
+  q.seeds.clear();
+  for (int seed = 1; seed <= pairs; ++seed) q.seeds.push_back(seed);
+  s.sequences.push_back(q);
+  return s;
+}
+
 int runEval(const EvalOptions& o) {
-  Suite suite = loadSuite(o.suite);
+  if (o.suite.empty() == o.sequence.scans.empty())
+    throw InputError("give a suite file, or a sequence as --scans DIR --poses FILE (not both)");
+  if (!o.sequence.scans.empty() && o.sequence.poses.empty()) throw InputError("--scans needs --poses");
+  Suite suite = o.suite.empty() ? sequenceSuite(o.sequence, o.sequence_pairs) : loadSuite(o.suite);
   if (!o.methods.empty()) {
     suite.methods = o.methods;
     for (auto& y : suite.synth) y.methods.clear();  // the command line decides for every pair
@@ -264,6 +285,40 @@ int runEval(const EvalOptions& o) {
                              c.name + " g" + shortNumber(c.grid), c.methods});
     }
 
+  // A sequence is read, and its up found, once for all its blocks and seeds.
+  std::map<std::pair<std::string, std::string>, std::vector<PosedScan>> sequences;
+  std::map<std::tuple<std::string, std::string, double>, Eigen::Vector3d> ups;
+  for (const auto& q : suite.sequences)
+    for (int64_t seed : q.seeds) {
+      synth::SequencePairParams params;
+      params.seed = static_cast<uint64_t>(seed);
+      params.level = q.level;
+      params.max_range = q.range;
+      params.move_xy = q.move;
+      auto& scans = sequences[{q.scans, q.poses}];
+      if (scans.empty()) {
+        std::cerr << "reading the sequence " << q.scans << " posed by " << q.poses << "\n";
+        scans = loadPosedScans(q.scans, q.poses);
+      }
+      const auto up_key = std::make_tuple(q.scans, q.poses, q.range);
+      if (!ups.count(up_key)) ups[up_key] = synth::sequenceUp(scans, params);
+      const std::string variant = q.level ? "level" : "lean";
+      const std::string folder = q.name + "-" + std::to_string(seed) + "-g" + shortNumber(q.grid) + "-" + variant;
+      std::cerr << "cutting " << folder << "\n";
+      std::string what;
+      GeneratedWorld w;
+      try {
+        w = writeSequencePair(scans, ups[up_key], params, (out / "worlds" / folder).string(), &what);
+      } catch (const synth::SmallCrop& e) {
+        skipped.push_back(folder + ": " + e.what());
+        std::cerr << "tomomap eval: warning: skipping " << skipped.back() << "\n";
+        continue;
+      }
+      suite.pairs.push_back({q.name + "-" + std::to_string(seed) + "-g" + shortNumber(q.grid) + "-" + what, w.maps[0],
+                             w.maps[1], w.poses[0], w.poses[1], q.grid, "real",
+                             q.name + " g" + shortNumber(q.grid) + (q.level ? " levelled" : " leaning"), q.methods});
+    }
+
   std::ofstream rows_csv(out / "rows.csv");
   std::ofstream rows_json(out / "rows.jsonl");
   rows_csv << kCsvHeader << "\n";
@@ -290,6 +345,9 @@ int runEval(const EvalOptions& o) {
                                   {"translation_error_m", std::isnan(r.translation_error)
                                                               ? nlohmann::json()
                                                               : nlohmann::json(r.translation_error)},
+                                  {"translation_error_at_origin_m", std::isnan(r.origin_error)
+                                                                        ? nlohmann::json()
+                                                                        : nlohmann::json(r.origin_error)},
                                   {"yaw_error_rad",
                                    std::isnan(r.yaw_error) ? nlohmann::json() : nlohmann::json(r.yaw_error)},
                                   {"wall_s", r.seconds},
@@ -325,7 +383,25 @@ Command addEvalCommand(CLI::App& app) {
   auto o = std::make_shared<EvalOptions>();
   CLI::App* sub =
       app.add_subcommand("eval", "Run every pair of a suite through tomomap and the methods it is measured against.");
-  sub->add_option("SUITE", o->suite, "suite file (TOML): [[pair]], [[synth]] and [[scan]] tables")->required();
+  sub->add_option("SUITE", o->suite, "suite file (TOML): [[pair]], [[synth]], [[scan]] and [[sequence]] tables");
+  // A user's own SLAM output: how tomomap would do on their robots' maps.
+  sub->add_option("--scans", o->sequence.scans,
+                  "instead of a suite: a folder of keyframe scans (one .pcd/.ply/.xyz a keyframe, in name order), "
+                  "cut into two robots' maps per pair")
+      ->check(CLI::ExistingDirectory);
+  sub->add_option("--poses", o->sequence.poses, "the keyframes' poses (KITTI, TUM or FAST-LIO's format), one a scan")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--pairs", o->sequence_pairs, "with --scans: how many pairs to cut (seeds 1..N)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
+  sub->add_option("-g,--grid", o->sequence.grid, "with --scans: grid size to match at [m]")
+      ->capture_default_str()
+      ->check(gridSize());
+  sub->add_flag("--level", o->sequence.level,
+                "with --scans: level each map (as if the SLAM saved it gravity-aligned) instead of leaning as saved");
+  sub->add_option("--range", o->sequence.range, "with --scans: each scan's points kept within this range [m]")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   sub->add_option("-o,--out", o->out, "output directory (rows.csv, rows.jsonl, summary.md, boxplots.png, worlds/)")
       ->capture_default_str();
   sub->add_option("-m,--methods", o->methods, "override the suite's methods (tomomap, fpfh-ransac, paper-consensus)")

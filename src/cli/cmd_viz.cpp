@@ -25,8 +25,8 @@ int runViz(const VizOptions& o) {
   const MatchResult& r = m.result;
   const double g = o.files.params.grid;
   std::optional<GroundTruthCheck> gt;
-  if (m.P_target && m.P_source) gt = checkAgainstGroundTruth(r, *m.P_target, *m.P_source, g);
-  const int code = report(r, m.P_target, m.P_source, g, {o.files.json, "tomomap", o.files.quiet}, m.inputs);
+  if (m.truth) gt = checkAgainstGroundTruth(r, *m.truth, g);
+  const int code = report(r, m.truth, g, {o.files.json, "tomomap", o.files.quiet}, m.inputs);
 
   const auto& T = r.T_target_source;
   std::vector<std::string> caption{

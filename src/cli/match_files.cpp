@@ -26,7 +26,14 @@ struct Described {
   std::string out, err;  ///< for stdout and stderr
 };
 
-Described describeFile(const std::string& path, const std::string& role, const MatchParams& params, bool quiet) {
+/// x, y, z from an --up option, if given.
+std::optional<Eigen::Vector3d> upOf(const std::vector<double>& v) {
+  if (v.empty()) return std::nullopt;
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+Described describeFile(const std::string& path, const std::string& role, const MatchParams& params, bool quiet,
+                       const std::vector<double>& up, Points* sample = nullptr) {
   Described d;
   size_t nonfinite = 0;
   std::string note;
@@ -41,12 +48,16 @@ Described describeFile(const std::string& path, const std::string& role, const M
     d.err +=
         "warning: " + path + ": dropped " + std::to_string(nonfinite) + " points with NaN or infinite coordinates\n";
   if (!quiet) d.out += role + " " + path + " (" + std::to_string(map.size()) + " points)\n";
-  d.features = describeMap(map, params, &d.spent);
+  if (sample) *sample = sourceSample(map);
+  d.features = describeMap(map, params, &d.spent, nullptr, nullptr, upOf(up));
   const MapFeatures& f = d.features;
   if (f.leveled)
     d.err += "note: " + path + ": levelled: it leaned " + fixed(degrees(f.tilt.angle), 1) + " +- " +
-             fixed(degrees(f.tilt.uncertainty), 1) + " deg from gravity (read off its " +
-             (f.tilt.cue == Tilt::Cue::floors ? "floors" : "walls") + ")\n";
+             fixed(degrees(f.tilt.uncertainty), 1) + " deg from gravity (" +
+             (f.tilt.cue == Tilt::Cue::given    ? "as given"
+              : f.tilt.cue == Tilt::Cue::floors ? "read off its floors"
+                                                : "read off its walls") +
+             ")\n";
   d.inputs[role + "_stray_voxels"] = f.occupancy.stray;
   if (f.occupancy.stray > 0)
     d.err += "warning: " + path + ": left out " + std::to_string(f.occupancy.stray) +
@@ -63,8 +74,8 @@ MatchedFiles matchFiles(MatchFilesOptions o) {
   params.max_tilt = radians(o.max_tilt_deg);
   requireBothOrNeither(o.gt_target, o.gt_source);
   MatchedFiles m;
-  if (!o.gt_target.empty()) m.P_target = loadPoseFile(o.gt_target);
-  if (!o.gt_source.empty()) m.P_source = loadPoseFile(o.gt_source);
+  if (!o.gt_target.empty()) m.truth = GroundTruth{loadPoseFile(o.gt_target), loadPoseFile(o.gt_source), {}};
+  Points* sample = m.truth ? &m.truth->source_sample : nullptr;
 
   // With two threads or more both maps are read and described at once, each
   // on one thread: the building (1.85 M points a map) at g 0.2 in 0.12 s
@@ -74,11 +85,11 @@ MatchedFiles matchFiles(MatchFilesOptions o) {
   MatchParams each = params;
   if (together) each.threads = 1;
   auto target_job = std::async(together ? std::launch::async : std::launch::deferred,
-                               [&] { return describeFile(o.target, "target", each, o.quiet); });
+                               [&] { return describeFile(o.target, "target", each, o.quiet, o.up_target); });
   std::optional<Described> source;
   std::exception_ptr source_failed;
   if (together) try {
-      source = describeFile(o.source, "source", each, o.quiet);
+      source = describeFile(o.source, "source", each, o.quiet, o.up_source, sample);
     } catch (...) {
       source_failed = std::current_exception();
     }
@@ -98,7 +109,7 @@ MatchedFiles matchFiles(MatchFilesOptions o) {
   say(target);
   m.target = std::move(target.features);
   if (source_failed) std::rethrow_exception(source_failed);
-  if (!source) source = describeFile(o.source, "source", each, o.quiet);
+  if (!source) source = describeFile(o.source, "source", each, o.quiet, o.up_source, sample);
   say(*source);
   m.source = std::move(source->features);
   if (!o.quiet) std::cout << "grid " << o.params.grid << " m\n";
@@ -126,6 +137,15 @@ void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
       ->check(settingRange("max_tilt_deg"));
   sub.add_flag("--level,!--no-level", o.params.level,
                "level a map tilted beyond --max-tilt (turn its up onto z; on by default); --no-level refuses it");
+  sub.add_flag("--finish,!--no-finish", o.params.finish,
+               "refine a reliable answer in all six degrees of freedom on the maps' occupancy (on by default)");
+  for (auto [name, v] : {std::pair{"--up-target", &o.up_target}, std::pair{"--up-source", &o.up_source}})
+    sub.add_option(name, *v,
+                   std::string("the ") + (v == &o.up_target ? "target" : "source") +
+                       " map's up direction X Y Z in its own frame, where it is known (an IMU's or the SLAM's "
+                       "gravity estimate): not estimated then, and the map levelled by it")
+        ->expected(3)
+        ->delimiter(',');
   sub.add_flag("--exhaustive", o.params.exhaustive,
                "match every slice pair instead of the height offsets the descriptor index points to "
                "(same answers, n^2 cost; for checking)");

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/matcher.hpp"
 #include "report.hpp"
@@ -14,13 +15,15 @@ struct MatchFilesOptions {
   std::string json;  ///< where to write the result as JSON ("-": stdout)
   MatchParams params;
   double max_tilt_deg = degrees(MatchParams{}.max_tilt);
+  /// Each map's up direction where the user knows it (x, y, z in the map's frame; empty: estimated).
+  std::vector<double> up_target, up_source;
   bool progress = false, quiet = false;
 };
 
 struct MatchedFiles {
   MapFeatures target, source;
   MatchResult result;
-  std::optional<Eigen::Matrix4d> P_target, P_source;  ///< ground truth, when given
+  std::optional<GroundTruth> truth;  ///< when given
   nlohmann::json inputs;  ///< for the JSON: each map's path, points, points dropped, stray voxels
 };
 
@@ -30,7 +33,8 @@ struct MatchedFiles {
 /// once described: half the peak memory on large maps). Then matches.
 MatchedFiles matchFiles(MatchFilesOptions o);
 
-/// Adds --grid, --json, --gt-target, --gt-source, --features, -j, --max-tilt, --level, --exhaustive, --progress, -q.
+/// Adds --grid, --json, --gt-target, --gt-source, --features, -j, --max-tilt, --level, --up-target, --up-source,
+/// --exhaustive, --progress, -q.
 void addMatchOptions(CLI::App& sub, MatchFilesOptions& o);
 
 }  // namespace tomomap::cli

@@ -1,5 +1,7 @@
 #include "report.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -25,15 +27,27 @@ nlohmann::json tiltJson(double tilt) { return tilt < 0 ? nlohmann::json() : nloh
 
 }  // namespace
 
-GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const Eigen::Matrix4d& P_target,
-                                         const Eigen::Matrix4d& P_source, double grid) {
+Points sourceSample(const Points& source) {
+  const size_t stride = std::max<size_t>(1, (source.size() + kErrorSamplePoints - 1) / kErrorSamplePoints);
+  Points sample;
+  for (size_t i = 0; i < source.size(); i += stride) sample.push_back(source[i]);
+  return sample;
+}
+
+GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const GroundTruth& truth, double grid) {
   GroundTruthCheck c;
-  const Eigen::Matrix4d expected = P_target * P_source.inverse();
-  c.expected = Pose4::fromMatrix(expected);
+  const Eigen::Matrix4d expected = truth.P_target * truth.P_source.inverse();
+  c.expected = expected;
   // Whole matrices: with a levelled map the answer is no longer 4-DoF, and the
   // rotation error is then the full angle between the two rotations.
   const Eigen::Matrix4d estimate = r.matrix();
-  c.error.translation = (estimate.topRightCorner<3, 1>() - expected.topRightCorner<3, 1>()).norm();
+  const Eigen::Matrix4d miss = estimate - expected;  // (E - G) p: how far E puts p from where G does
+  c.at_origin = miss.topRightCorner<3, 1>().norm();
+  double squares = 0;
+  for (const auto& p : truth.source_sample) squares += (miss * p.cast<double>().homogeneous()).squaredNorm();
+  c.error.translation = truth.source_sample.empty()
+                            ? c.at_origin
+                            : std::sqrt(squares / static_cast<double>(truth.source_sample.size()));
   c.error.yaw =
       Eigen::AngleAxisd(Eigen::Matrix3d(estimate.topLeftCorner<3, 3>().transpose() * expected.topLeftCorner<3, 3>()))
           .angle();
@@ -53,7 +67,7 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
                  const std::string& method) {
   out << resultLine(r) << "\n";
   if (r.reliable) {
-    if (r.T_target_source_unleveled) out << "  between the levelled maps; in the maps' own frames:\n";
+    if (r.T_target_source_6dof) out << "  its x, y, z and yaw; the whole transform between the maps' own frames:\n";
     const Eigen::Matrix4d M = r.matrix();
     for (int i = 0; i < 4; ++i) out << format("  [%9.5f %9.5f %9.5f %9.4f]\n", M(i, 0), M(i, 1), M(i, 2), M(i, 3));
   }
@@ -78,22 +92,32 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
       out << format("                 with the maps' roles swapped, the source's origin %.3f m from its pose\n",
                     *r.dense_second_look_apart);
     out << "tilt             target " << tiltText(r.target_tilt) << ", source " << tiltText(r.source_tilt) << "\n";
+    if (r.finish && r.finish->held)
+      out << format("6-DoF finish     corrected %.2f deg of roll and pitch, moved the source %.3f m; %.0f %% of its "
+                    "cells on the target's surfaces (%.0f %% before)\n",
+                    degrees(r.finish->roll_pitch_corrected), r.finish->moved, 100 * r.finish->seen_found_after,
+                    100 * r.finish->seen_found_before);
+    else if (r.finish)
+      out << "6-DoF finish     kept the 4-DoF answer: " << r.finish->why_not << "\n";
     out << format(
         "slices           target %d (%zu features), source %d (%zu features), %zu of %zu slice pairs matched\n",
         r.target_slices, r.target_features, r.source_slices, r.source_features, r.slice_pairs, r.slice_pairs_total);
     const auto& t = r.timings;
     out << format(
         "time             %.3f s: load %.3f, voxel %.3f, slicing %.3f, features %.3f, pair matching %.3f, "
-        "consensus %.3f, refinement %.3f, dense search %.3f\n",
-        t.total(), t.load, t.voxel, t.slicing, t.features, t.pair_matching, t.consensus, t.refinement, t.dense);
+        "consensus %.3f, refinement %.3f, dense search %.3f, 6-DoF finish %.3f\n",
+        t.total(), t.load, t.voxel, t.slicing, t.features, t.pair_matching, t.consensus, t.refinement, t.dense,
+        t.finish);
   }
   if (gt) {
-    const auto& e = gt->expected;
+    const Pose4 e = Pose4::fromMatrix(gt->expected);
     out << format("ground truth     x %.4f  y %.4f  z %.4f m  yaw %.4f rad\n", e.x, e.y, e.z, e.yaw);
     if (r.reliable)
-      out << format("error            translation %.4f m (limit %.3f), yaw %.4f rad (limit %.4f): %s\n",
-                    gt->error.translation, gt->translation_limit, gt->error.yaw, gt->yaw_limit,
-                    gt->success() ? "success" : "FAILURE");
+      out << format(
+          "error            translation %.4f m over the source's points (limit %.3f; %.4f m at its origin), "
+          "rotation %.4f rad (limit %.4f): %s\n",
+          gt->error.translation, gt->translation_limit, gt->at_origin, gt->error.yaw, gt->yaw_limit,
+          gt->success() ? "success" : "FAILURE");
   }
 }
 
@@ -102,11 +126,23 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
   j["reliable"] = r.reliable;
   if (r.reliable) {
     j["T_target_source"] = tomomap::toJson(r.T_target_source);
-    if (r.T_target_source_unleveled) j["T_target_source_unleveled"] = matrixJson(*r.T_target_source_unleveled);
+    if (r.T_target_source_6dof) j["T_target_source_6dof"] = matrixJson(*r.T_target_source_6dof);
   } else {
     j["reason"] = r.reason;
   }
   j["tilt_deg"] = {{"target", tiltJson(r.target_tilt)}, {"source", tiltJson(r.source_tilt)}};
+  if (r.finish) {
+    const SixDofFinish& f = *r.finish;
+    j["finish"] = {{"held", f.held},
+                   {"roll_pitch_corrected_deg", degrees(f.roll_pitch_corrected)},
+                   {"moved_m", f.moved},
+                   {"rms_m", {f.rms_before, f.rms_after}},
+                   {"on_surface", {f.seen_found_before, f.seen_found_after}},
+                   {"iterations", f.iterations}};
+    if (!f.held) j["finish"]["why_not"] = f.why_not;
+  } else {
+    j["finish"] = nullptr;
+  }
   j["quality"] = {{"method", r.method},
                   {"dense_lead", r.dense_lead},
                   {"dense_cell", r.dense_cell},
@@ -135,20 +171,24 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
                     {"consensus", t.consensus},
                     {"refinement", t.refinement},
                     {"dense", t.dense},
+                    {"finish", t.finish},
                     {"total", t.total()}};
   if (gt) {
-    j["ground_truth"] = tomomap::toJson(gt->expected);
+    j["ground_truth"] = tomomap::toJson(Pose4::fromMatrix(gt->expected));
+    j["ground_truth"]["matrix"] = matrixJson(gt->expected);
     if (r.reliable)
-      j["error"] = {{"translation", gt->error.translation}, {"yaw", gt->error.yaw}, {"success", gt->success()}};
+      j["error"] = {{"translation", gt->error.translation},
+                    {"translation_at_origin", gt->at_origin},
+                    {"yaw", gt->error.yaw},
+                    {"success", gt->success()}};
   }
   return j;
 }
 
-int report(const MatchResult& r, const std::optional<Eigen::Matrix4d>& P_target,
-           const std::optional<Eigen::Matrix4d>& P_source, double grid, const ReportOptions& how,
+int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double grid, const ReportOptions& how,
            const nlohmann::json& extra) {
   std::optional<GroundTruthCheck> gt;
-  if (P_target && P_source) gt = checkAgainstGroundTruth(r, *P_target, *P_source, grid);
+  if (truth) gt = checkAgainstGroundTruth(r, *truth, grid);
   const bool json_to_stdout = how.json == "-";
   std::ostream& text = json_to_stdout ? std::cerr : std::cout;
   if (how.quiet)

@@ -83,7 +83,7 @@ Suite loadSuite(const std::string& path) {
   } catch (const toml::parse_error& e) {
     fail(path, e.source(), std::string(e.description()));
   }
-  checkKeys(path, root, {"name", "methods", "pair", "synth", "scan"}, "the suite");
+  checkKeys(path, root, {"name", "methods", "pair", "synth", "scan", "sequence"}, "the suite");
   const fs::path base = fs::path(path).parent_path();
   auto resolve = [&](const std::string& p) {
     return fs::path(p).is_absolute() ? p : (base / p).lexically_normal().string();
@@ -158,7 +158,34 @@ Suite loadSuite(const std::string& path) {
     else
       s.scans.push_back(c);
   });
-  if (s.pairs.empty() && s.synth.empty() && s.scans.empty() && s.warnings.empty())
+  forEachTable(path, root, "sequence", [&](const toml::table& t) {
+    checkKeys(path, t, {"folder", "scans", "poses", "name", "seeds", "grid", "level", "range", "move", "methods"},
+              "[[sequence]]");
+    SuiteSequence q;
+    if (!t.get("folder") && !(t.get("scans") && t.get("poses")))
+      fail(path, t.source(), "[[sequence]] needs 'folder', or 'scans' and 'poses'");
+    // A folder as the shared sequences and many SLAM packages lay it out
+    // (scans/ and optimized_poses.txt), or the two named apart.
+    const std::string folder = resolve(text(path, t, "folder", "[[sequence]]", ""));
+    q.scans = resolve(text(path, t, "scans", "[[sequence]]", (fs::path(folder) / "scans").string()));
+    q.poses = resolve(text(path, t, "poses", "[[sequence]]", (fs::path(folder) / "optimized_poses.txt").string()));
+    q.name = text(path, t, "name", "[[sequence]]",
+                  fs::path(folder.empty() ? q.scans : folder).lexically_normal().filename().string());
+    q.seeds = list<int64_t>(path, t, "seeds", q.seeds);
+    q.grid = number(path, t, "grid", q.grid);
+    if (const toml::node* n = t.get("level")) {
+      if (!n->is_boolean()) fail(path, n->source(), "'level' must be true or false");
+      q.level = n->value<bool>().value();
+    }
+    q.range = number(path, t, "range", q.range);
+    q.move = number(path, t, "move", q.move);
+    q.methods = blockMethods(t);
+    if (!fs::is_directory(q.scans) || !fs::exists(q.poses))
+      s.warnings.push_back("sequence '" + q.name + "' left out: " + q.scans + " or " + q.poses + ": no such file");
+    else
+      s.sequences.push_back(q);
+  });
+  if (s.pairs.empty() && s.synth.empty() && s.scans.empty() && s.sequences.empty() && s.warnings.empty())
     throw InputError(path + ": the suite lists no pairs");
   return s;
 }

@@ -6,6 +6,7 @@
 
 #include "core/matcher.hpp"
 #include "synth/scan_pairs.hpp"
+#include "synth/sequence_pairs.hpp"
 
 namespace tomomap::cli {
 
@@ -40,6 +41,19 @@ struct SuiteScan {
   std::vector<std::string> methods;  ///< as for [[synth]]
 };
 
+/// Two robots' maps cut from one posed SLAM sequence (synth/sequence_pairs.hpp), one pair per seed.
+struct SuiteSequence {
+  std::string scans;  ///< the folder of keyframe scans (resolved against the suite's folder)
+  std::string poses;  ///< their pose file: KITTI, TUM or FAST-LIO's (io/pose_sequence.hpp)
+  std::string name;   ///< family name; default: the sequence folder's name
+  std::vector<int64_t> seeds{1};
+  double grid = MatchParams{}.grid;  ///< [m]
+  bool level = false;                ///< each map levelled instead of leaning as its SLAM saved it
+  double range = synth::SequencePairParams{}.max_range;  ///< each scan's points kept within [m]
+  double move = synth::SequencePairParams{}.move_xy;     ///< the source's largest x, y move [m]
+  std::vector<std::string> methods;                      ///< as for [[synth]]
+};
+
 /// Every method a suite may name: tomomap, and the baselines it is measured
 /// against (tomomap-baseline --method).
 inline const std::vector<std::string> kEvalMethods{"tomomap", "fpfh-ransac", "paper-consensus"};
@@ -50,6 +64,7 @@ struct Suite {
   std::vector<SuitePair> pairs;
   std::vector<SuiteSynth> synth;
   std::vector<SuiteScan> scans;
+  std::vector<SuiteSequence> sequences;
   std::vector<std::string> warnings;  ///< pairs left out (missing files), with the reason
 };
 

@@ -86,4 +86,26 @@ GeneratedWorld writeScanPair(const std::string& scan_file, const synth::ScanPair
   return out;
 }
 
+GeneratedWorld writeSequencePair(const std::vector<PosedScan>& scans, const Eigen::Vector3d& up,
+                                 const synth::SequencePairParams& params, const std::string& dir, std::string* name) {
+  makeFolder(dir);
+  const synth::SequencePair pair = synth::makeSequencePair(scans, up, params);
+  GeneratedWorld out = writeMaps({&pair.target, &pair.source}, dir);
+  const auto& i = pair.info;
+  std::ofstream(std::filesystem::path(dir) / "pair.json")
+      << nlohmann::json{{"seed", params.seed},
+                        {"keyframes", {{"target", {i.target_first, i.target_last}}, {"source", {i.source_first, i.source_last}}}},
+                        {"overlap", {{"target", i.target_overlap}, {"source", i.source_overlap}}},
+                        {"lean_deg", {{"target", degrees(i.target_lean)}, {"source", degrees(i.source_lean)}}},
+                        {"levelled", i.level},
+                        {"range_m", {params.min_range, params.max_range}},
+                        {"voxel_m", params.voxel},
+                        {"move", {{"x", i.move.x}, {"y", i.move.y}, {"z", i.move.z}, {"yaw_deg", degrees(i.move.yaw)}}},
+                        {"points", out.points}}
+             .dump(2)
+      << "\n";
+  if (name) *name = synth::describe(i);
+  return out;
+}
+
 }  // namespace tomomap::cli

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "synth/scan_pairs.hpp"
+#include "synth/sequence_pairs.hpp"
 #include "synth/synth.hpp"
 
 namespace tomomap::cli {
@@ -25,5 +26,12 @@ GeneratedWorld writeSynthWorld(const synth::SceneParams& params, const synth::No
 /// `name` is set to what the pair is (synth::describe).
 GeneratedWorld writeScanPair(const std::string& scan_file, const synth::ScanPairParams& params, const std::string& dir,
                              std::string* name = nullptr);
+
+/// Cuts two robots' maps from a posed sequence (synth::makeSequencePair; `up`
+/// from synth::sequenceUp) and writes map_0.pcd (target), map_1.pcd (source),
+/// their poses and pair.json into `dir`; `name` is set to what the pair is.
+GeneratedWorld writeSequencePair(const std::vector<PosedScan>& scans, const Eigen::Vector3d& up,
+                                 const synth::SequencePairParams& params, const std::string& dir,
+                                 std::string* name = nullptr);
 
 }  // namespace tomomap::cli

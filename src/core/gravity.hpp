@@ -8,29 +8,27 @@
 
 namespace tomomap {
 
-/// How many standard errors a tilt estimate must clear: its error, to be
-/// levelled by (within the tolerance); its excess over the tolerance, to be
-/// refused as tilted.
-constexpr double kTiltSigmas = 3.0;
-
 struct Tilt {
   bool measured = false;              ///< enough flat surfaces to tell; if not, the rest means nothing
   double angle = 0;                   ///< between the map's z axis and `up` [rad]
   Eigen::Vector3d up{0.0, 0.0, 1.0};  ///< the estimated up direction in the map frame (unit, z >= 0)
-  /// The standard error of `angle` [rad]: the spread of the cue's normals
-  /// about `up` over the square root of their count.
+  /// How far `up` may be off [rad]: the farthest the same estimate reads on
+  /// parts of the map that can check it (fairPart: its halves, a third and a
+  /// tenth of its points) plus the cue's standard error; at least `angle`
+  /// where most parts cannot check it (the lean is then not known better than it is).
   double uncertainty = 0;
   /// What `up` was read from: floors (and ground, ceilings), or walls where
-  /// there are too few floors.
-  enum class Cue { floors, walls } cue = Cue::floors;
+  /// there are too few floors; or given by the user (an IMU's or the SLAM's
+  /// own gravity), then exact.
+  enum class Cue { floors, walls, given } cue = Cue::floors;
   size_t floor_patches = 0;  ///< flat patches facing up (floors, ceilings, ground)
   size_t wall_patches = 0;   ///< flat patches facing sideways (walls)
 
-  /// Whether the estimate is good to level by: within `tolerance` at kTiltSigmas standard errors.
-  bool levelable(double tolerance) const { return measured && kTiltSigmas * uncertainty <= tolerance; }
-  /// Whether the map may lie within `tolerance`: its tilt is not beyond it by
-  /// kTiltSigmas standard errors (or not measured).
-  bool mayBeWithin(double tolerance) const { return !measured || angle - kTiltSigmas * uncertainty <= tolerance; }
+  /// Whether the estimate is good to level by: its uncertainty within `tolerance`.
+  bool levelable(double tolerance) const { return measured && uncertainty <= tolerance; }
+  /// Whether the map may lie within `tolerance`: its tilt less its
+  /// uncertainty not beyond it (or not measured).
+  bool mayBeWithin(double tolerance) const { return !measured || angle - uncertainty <= tolerance; }
 
   /// The rotation that makes the map level: it turns `up` onto z (the
   /// smallest such rotation: no yaw is added).
@@ -46,8 +44,19 @@ const double kMaxLevelable = radians(30.0);
 /// cube gives a normal; `up` is the floors' mean normal, or the direction the
 /// walls' normals avoid where there are too few floors; found from z in a few
 /// rounds, then again in the frame levelled so far. On sloping ground it reads
-/// the slope.
+/// the slope. Its uncertainty is measured on the map's parts (Tilt::uncertainty).
 Tilt estimateTilt(const Points& map, double grid);
+
+/// A part of a map (a crop, a thinning) checks the whole's estimate where it
+/// is read off the same cue and holds at least this share of the whole's
+/// patches of that cue: a half holds about half of them, a tenth of the
+/// points 0.5-0.8 of them on the real maps.
+constexpr double kFairShare = 0.25;
+bool fairPart(const Tilt& part, const Tilt& whole);
+
+/// The tilt of a map whose up direction is known (`up` in the map's frame,
+/// any length): exact, to be levelled by whatever it leans.
+Tilt givenTilt(const Eigen::Vector3d& up);
 
 /// Rotates every point by `rotation` (about the origin).
 Points rotatePoints(const Points& in, const Eigen::Quaterniond& rotation);

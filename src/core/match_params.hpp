@@ -34,6 +34,10 @@ struct MatchParams {
   /// Level a map tilted beyond max_tilt (turn its up onto z) where the tilt is
   /// measured well enough (Tilt::levelable), instead of refusing it.
   bool level = true;
+  /// Refine a reliable answer in all six degrees of freedom on the maps'
+  /// occupancy (six_dof_finish.hpp): the roll and pitch two imperfectly
+  /// levelled maps leave between them.
+  bool finish = true;
 };
 
 /// Whether a winning answer with `support` agreeing slice pairs is weak: below

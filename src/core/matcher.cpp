@@ -35,13 +35,13 @@ Eigen::Vector3d inlierSpread(const Refined& r) {
 }
 
 /// p_target = R_target^-1 T R_source p_source, with R a map's levelling rotation.
-Eigen::Matrix4d unleveled(const Pose4& T, const MapFeatures& target, const MapFeatures& source) {
+Eigen::Matrix4d unleveled(const Eigen::Matrix4d& T, const MapFeatures& target, const MapFeatures& source) {
   const auto rotation = [](const MapFeatures& m) {
     Eigen::Matrix4d R = Eigen::Matrix4d::Identity();
     if (m.leveled) R.topLeftCorner<3, 3>() = m.tilt.leveling().toRotationMatrix();
     return R;
   };
-  return rotation(target).inverse() * T.matrix() * rotation(source);
+  return rotation(target).inverse() * T * rotation(source);
 }
 
 /// The tomographic match of two maps' feature stacks: its figures into `r`,
@@ -125,7 +125,7 @@ std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string
 }
 
 MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings, size_t* filtered_points,
-                        const MapFeatures* previous) {
+                        const MapFeatures* previous, const std::optional<Eigen::Vector3d>& up) {
   if (previous && previous->leveled) previous = nullptr;  // its cubes and raster were the levelled map's
   StageTimings local;
   StageTimings& t = timings ? *timings : local;
@@ -134,8 +134,9 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   // points alone, and took as long as both on a street): the map is sliced
   // before the tilt is known, and sliced again in the rare case it is levelled.
   // From the raw points: the filter's grid would bias a leaning plane's normals towards the axes.
-  std::future<Tilt> tilt_estimate = std::async(threads > 1 ? std::launch::async : std::launch::deferred,
-                                               [&] { return estimateTilt(map, params.grid); });
+  std::future<Tilt> tilt_estimate =
+      std::async(threads > 1 && !up ? std::launch::async : std::launch::deferred,
+                 [&] { return up ? givenTilt(*up) : estimateTilt(map, params.grid); });
   auto t0 = Clock::now();
   Eigen::Vector3f corner = previous ? previous->voxel_corner : Eigen::Vector3f::Constant(NAN);
   Points filtered = voxelFilter(map, params.grid, &corner);
@@ -145,9 +146,12 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
       makeSlices(filtered, params.grid, threads, previous ? &previous->occupancy : nullptr, params.sparsest_slice);
   const Tilt tilt = tilt_estimate.get();
   // Only a map that would be refused: levelling a level map by the estimate's
-  // own error (0.6 deg on demo-pcd1) cost 3 cm and 0.6 deg on demo-room.
-  const bool level =
-      params.level && tilt.angle > params.max_tilt && tilt.angle <= kMaxLevelable && tilt.levelable(params.max_tilt);
+  // own error (0.6 deg on demo-pcd1) cost 3 cm and 0.6 deg on demo-room. A
+  // known up has no error: the map is levelled by whatever it leans.
+  const bool known = tilt.cue == Tilt::Cue::given;
+  const bool level = params.level && (known ? tilt.angle > 0.0
+                                            : tilt.angle > params.max_tilt && tilt.angle <= kMaxLevelable &&
+                                                  tilt.levelable(params.max_tilt));
   if (level) {
     // The levelled map is filtered again: rotated voxels no longer sit on the grid.
     filtered = voxelFilter(rotatePoints(filtered, tilt.leveling()), params.grid);
@@ -191,7 +195,22 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
     matchSlices(r, e.features, target, source, params, progress, cache);
   }
   settleMatch(r, e, target, source, params);
-  if (target.leveled || source.leveled) r.T_target_source_unleveled = unleveled(r.T_target_source, target, source);
+  Eigen::Matrix4d answer = r.T_target_source.matrix();  // between the levelled frames
+  if (r.reliable && params.finish) {
+    // The finish works on what the daemon has of a peer's map too: its
+    // occupancy (empty there where the slices came without it: not held).
+    const auto t0 = Clock::now();
+    SixDofFinishParams finish;
+    finish.threads = matchThreads(params);
+    r.finish = finishSixDof(target.occupancy, source.occupancy, answer, finish);
+    r.timings.finish = secondsSince(t0);
+    if (r.finish->held) {
+      answer = r.finish->T_target_source;
+      r.T_target_source = Pose4::fromMatrix(answer);
+    }
+  }
+  if (target.leveled || source.leveled || (r.finish && r.finish->held))
+    r.T_target_source_6dof = unleveled(answer, target, source);
   return r;
 }
 

@@ -5,6 +5,7 @@
 
 #include "match_params.hpp"
 #include "rigid2d.hpp"
+#include "six_dof_finish.hpp"
 #include "slice_pairs.hpp"
 
 namespace tomomap {
@@ -13,7 +14,10 @@ namespace tomomap {
 struct StageTimings {
   double load = 0;  ///< reading the map files (filled where they are read)
   double voxel = 0, slicing = 0, features = 0, pair_matching = 0, consensus = 0, refinement = 0, dense = 0;
-  double total() const { return load + voxel + slicing + features + pair_matching + consensus + refinement + dense; }
+  double finish = 0;  ///< the 6-DoF finish (six_dof_finish.hpp)
+  double total() const {
+    return load + voxel + slicing + features + pair_matching + consensus + refinement + dense + finish;
+  }
   /// Takes the map-description stages (as describeMap fills them) and the load time from `d`.
   void takeDescription(const StageTimings& d) {
     load = d.load;
@@ -34,14 +38,20 @@ struct MatchResult {
   /// must not be used; `reason` says why.
   bool reliable = false;
   std::string reason;
-  Pose4 T_target_source;  ///< p_target = T_target_source * p_source (between the levelled frames, if levelled)
-  /// When a map was levelled: the transform between the maps' own frames,
-  /// leveling included (no longer 4-DoF). Empty otherwise.
-  std::optional<Eigen::Matrix4d> T_target_source_unleveled;
+  /// p_target = T_target_source * p_source (between the levelled frames, if
+  /// levelled): the 4-DoF answer, or the x, y, z and yaw of the 6-DoF finish where it held.
+  Pose4 T_target_source;
+  /// The whole transform between the maps' own frames, where it is not 4-DoF:
+  /// a map was levelled (its levelling included), or the 6-DoF finish held
+  /// (its roll and pitch included). Empty otherwise.
+  std::optional<Eigen::Matrix4d> T_target_source_6dof;
+  /// The 6-DoF finish of a reliable answer (six_dof_finish.hpp): what it
+  /// corrected, or why it kept the 4-DoF answer. Empty where it did not run.
+  std::optional<SixDofFinish> finish;
   double target_tilt = 0, source_tilt = 0;  ///< as measured before any levelling [rad]; -1 = not measurable
 
   /// The transform to apply to source points to bring them into the target's frame.
-  Eigen::Matrix4d matrix() const { return T_target_source_unleveled.value_or(T_target_source.matrix()); }
+  Eigen::Matrix4d matrix() const { return T_target_source_6dof.value_or(T_target_source.matrix()); }
 
   /// What found T: "features" (the tomographic match) or "dense" (the dense
   /// search of small maps, when the verdict (verdict.hpp) takes its answer).
@@ -109,7 +119,10 @@ MatchResult matchMaps(const Points& target, const Points& source, const MatchPar
 /// filtered on its cubes and sliced on its raster while it stays within them,
 /// and the slices the change did not touch keep their features (kept_slices):
 /// the same description as from scratch on that raster, ORB only where it changed.
+/// With `up` (the map's up direction, known from an IMU or the SLAM), the
+/// tilt is not estimated: the map is levelled by it wherever it leans.
 MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings = nullptr,
-                        size_t* filtered_points = nullptr, const MapFeatures* previous = nullptr);
+                        size_t* filtered_points = nullptr, const MapFeatures* previous = nullptr,
+                        const std::optional<Eigen::Vector3d>& up = std::nullopt);
 
 }  // namespace tomomap

@@ -406,26 +406,16 @@ SixDofFinish finishSixDof(const SliceStack& target, const SliceStack& source, co
   result.inliers_after = after.inliers;
   result.rms_after = after.rms();
   result.seen_found_after = after.seenShare();
-  // More cells on their surfaces may well raise the rms a little (a start a few
-  // cells off holds mostly the floor, whose cells lie flat): only a fall in
-  // inliers or an rms beyond what aligned cells show refuses the result.
-  if (after.inliers < before.inliers) {
-    result.why_not = "the overlap got worse: " + std::to_string(before.inliers) + " -> " +
-                     std::to_string(after.inliers) + " cells within " + figure(last_radius, 1) +
-                     " cells of a target plane";
-    return result;
-  }
-  if (result.seen_found_after < params.min_seen_found) {
-    result.why_not = "too little overlap: " + figure(100 * result.seen_found_after, 0) +
-                     " % of the cells landing where the target saw anything lie on its surfaces, need " +
-                     figure(100 * params.min_seen_found, 0) + " %";
-    return result;
-  }
-  if (result.rms_after > params.max_rms_cells * cell) {
-    result.why_not = "residual grew: the inliers' rms " + figure(result.rms_before / cell) + " -> " +
-                     figure(result.rms_after / cell) + " cells, aligned cells show at most " +
-                     figure(params.max_rms_cells) + " (" + share(after.inliers) + " of the cells within " +
-                     figure(last_radius, 1) + " cells)";
+  // A finish holds where it left the maps fitting no worse than it found
+  // them: of the source's cells landing where the target saw anything, no
+  // fewer on the target's surfaces. That share is not a bar of its own: at
+  // the right pose real SLAM maps show 0.34-0.52 (trees, people, what one
+  // robot saw from a side the other did not), generated rooms 0.93; the
+  // verdict judged the pose, the finish only sharpens it.
+  if (result.seen_found_after < result.seen_found_before - params.seen_found_noise) {
+    result.why_not = "the fit got worse: " + figure(100 * result.seen_found_before, 1) + " -> " +
+                     figure(100 * result.seen_found_after, 1) +
+                     " % of the cells landing where the target saw anything lie on its surfaces";
     return result;
   }
   result.held = true;

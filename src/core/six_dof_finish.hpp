@@ -42,22 +42,16 @@ struct SixDofFinishParams {
   /// Fewer inliers than this share of the source cells used, at the start or at
   /// the end, is too little overlap to judge the result by [ratio].
   double min_overlap = 0.1;
-  /// The inliers' point-to-plane rms must stay under this [grid cells]: cell
-  /// centres on an aligned surface scatter 1/sqrt(12) = 0.29 cell about it,
-  /// cells that merely lie near another surface up to the radius/sqrt(3).
-  double max_rms_cells = 0.45;
-  /// Of the source cells landing in a column where the target saw anything, at
-  /// least this share must find their surface at the end [ratio]. At the right
-  /// pose only what the target did not see from its side is missing: 0.93-0.94
-  /// on the unit tests' rooms over 40 random leans of 0.5-3 degrees. At a wrong
-  /// pose a shared floor fits and little else: 0.43-0.57 with another building
-  /// or starts 1-3 m off, 0.70 where the rooms' repeating walls lined up.
-  double min_seen_found = 0.8;
+  /// A finish that leaves this much fewer of the source's cells on the
+  /// target's surfaces than it found [share] fits worse: it keeps the start.
+  /// At a pose the finish cannot improve, the share moves by a few cells in
+  /// ten thousand (0.1 %) as the cells settle.
+  double seen_found_noise = 0.005;
   int threads = 1;  ///< threads it uses (MatchParams::threads, resolved); the result does not depend on it
 };
 
 struct SixDofFinish {
-  bool held = false;    ///< it converged within bounds and the overlap did not get worse
+  bool held = false;    ///< it converged within bounds and the fit did not get worse
   std::string why_not;  ///< when not held: what went wrong, with figures
   Eigen::Matrix4d T_target_source =
       Eigen::Matrix4d::Identity();               ///< the refined transform (== the start when not held)

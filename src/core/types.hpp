@@ -67,6 +67,13 @@ struct Pose4 {
   }
 };
 
+/// One keyframe of a SLAM sequence: its points in the sensor (body) frame and
+/// where the SLAM put it.
+struct PosedScan {
+  Points points;
+  Eigen::Matrix4d T_world_body = Eigen::Matrix4d::Identity();  ///< p_world = T_world_body * p_body
+};
+
 /// Applies a transform to every point.
 inline Points transformPoints(const Points& in, const Pose4& T) {
   Points out;

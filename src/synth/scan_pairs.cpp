@@ -7,13 +7,6 @@
 
 namespace tomomap::synth {
 
-namespace {
-
-/// Fewer points than this per crop is no map to match.
-constexpr size_t kMinPointsPerCrop = 1000;
-
-}  // namespace
-
 ScanPair makeScanPair(const Points& scan, const ScanPairParams& params) {
   if (scan.size() < 2 * kMinPointsPerCrop)
     throw InputError("a scan of " + std::to_string(scan.size()) + " points is too small to cut into a pair (at least " +

@@ -39,6 +39,9 @@ struct ScanPair {
   ScanPairInfo info;
 };
 
+/// Fewer points than this in a cut map is no map to match.
+constexpr size_t kMinPointsPerCrop = 1000;
+
 /// A seed whose cut leaves a crop too small to be a map (the scan itself is
 /// fine: other seeds cut it). `tomomap eval` skips such a seed and says so.
 struct SmallCrop : InputError {

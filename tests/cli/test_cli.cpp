@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "results/json_schema.hpp"
 #include "support.hpp"
 
 using namespace tomomap;
@@ -360,7 +361,7 @@ TEST(Cli, ATiltedSynthMapIsLevelledAndRefusedWithNoLevel) {
   EXPECT_TRUE(l["error"]["success"].get<bool>()) << l.dump(2);
   EXPECT_LT(l["error"]["translation"].get<double>(), 0.15);
   EXPECT_LT(l["error"]["yaw"].get<double>(), radians(1.0)) << "the whole rotation, roll included";
-  EXPECT_TRUE(l.contains("T_target_source_unleveled"));
+  EXPECT_TRUE(l.contains("T_target_source_6dof"));
   EXPECT_LT(l["tilt_deg"]["target"].get<double>(), 0.5);
   EXPECT_NEAR(l["tilt_deg"]["source"].get<double>(), 10.0, 0.3);
 
@@ -449,7 +450,7 @@ TEST(Cli, TheJsonOutputIsTheDocumentedContract) {
   ASSERT_EQ(none.exit_code, 1) << none.output;
   const auto a = nlohmann::json::parse(readText(dir / "right.json"));
   const auto n = nlohmann::json::parse(readText(dir / "none.json"));
-  EXPECT_EQ(a["schema_version"], 1);
+  EXPECT_EQ(a["schema_version"], kJsonSchemaVersion);
   EXPECT_EQ(a["grid"], 0.1);
   EXPECT_EQ(a["target"], b + "map_0.pcd");
   EXPECT_EQ(a["tool"]["name"], "tomomap");
@@ -460,6 +461,6 @@ TEST(Cli, TheJsonOutputIsTheDocumentedContract) {
   std::set<std::string> documented = documentedJsonFields("`match --json`");
   ASSERT_FALSE(documented.empty());
   for (const auto& k : written) EXPECT_TRUE(documented.count(k)) << k << " is written but not in docs/json.md";
-  documented.erase("T_target_source_unleveled");  // only with --level
+  documented.erase("T_target_source_6dof");  // only with --level
   for (const auto& k : documented) EXPECT_TRUE(written.count(k)) << k << " is in docs/json.md but not written";
 }

@@ -79,7 +79,7 @@ TEST(Gravity, RealScansReadNearTheirGroundAndAreMatchedAsTheyAre) {
     EXPECT_EQ(f.tilt.cue, Tilt::Cue::floors) << file;
     EXPECT_GT(degrees(f.tilt.angle), 0.5) << file;
     EXPECT_LT(degrees(f.tilt.angle), degrees(params.max_tilt)) << file;
-    EXPECT_LT(degrees(f.tilt.uncertainty), 1.0) << file;
+    EXPECT_LT(degrees(f.tilt.uncertainty), 2.0) << file;  // its halves and thinnings read up to 1.7 deg apart
     EXPECT_FALSE(f.leveled) << file;
     EXPECT_FALSE(tiltRefusal(f, "target", params)) << file;
   }
@@ -108,8 +108,9 @@ TEST(Gravity, AFewScatteredPointsAreNotMeasured) {
 }
 
 TEST(Matcher, ATiltTooUncertainToLevelIsRefusedOnlyWhenItIsSurelyBeyondTheTolerance) {
-  // Figures of real LiDAR crops (a thinned nuScenes crop whose ground lies
-  // 1.6 deg off read 4.6 +- 1.1 deg) and of a surely tilted map.
+  // A lean read no better than the tolerance (the uncertainty: how far the
+  // map's parts read from the whole) is matched as it is where it may lie
+  // within the tolerance, and refused where it surely does not.
   const auto map = [](double deg, double sigma_deg) {
     MapFeatures f;
     f.tilt.measured = true;
@@ -118,10 +119,10 @@ TEST(Matcher, ATiltTooUncertainToLevelIsRefusedOnlyWhenItIsSurelyBeyondTheTolera
     return f;
   };
   const MatchParams params;  // matched as it is up to 3 deg, levelled where measured to 1 deg
-  EXPECT_FALSE(tiltRefusal(map(4.6, 1.1), "target", params)) << "may lie within 3 deg: matched as it is";
-  EXPECT_FALSE(tiltRefusal(map(5.9, 1.0), "target", params));
-  const auto surely = tiltRefusal(map(7.5, 1.4), "source", params);
-  ASSERT_TRUE(surely) << "beyond 3 deg by three standard errors, too uncertain to level";
+  EXPECT_FALSE(tiltRefusal(map(4.6, 3.5), "target", params)) << "may lie within 3 deg: matched as it is";
+  EXPECT_FALSE(tiltRefusal(map(5.9, 3.0), "target", params));
+  const auto surely = tiltRefusal(map(7.5, 4.0), "source", params);
+  ASSERT_TRUE(surely) << "beyond 3 deg by more than its uncertainty, too uncertain to level";
   EXPECT_NE(surely->find("not measured well enough to level"), std::string::npos) << *surely;
   EXPECT_TRUE(tiltRefusal(map(40, 20), "source", params)) << "beyond what is ever levelled";
   MatchParams no_level;
@@ -144,7 +145,7 @@ TEST(Matcher, ATiltedMapIsLevelledOrWithoutLevellingRefused) {
 
   const MatchResult r = matchMaps(demo.map1, rolled, MatchParams{});  // levelled by default
   ASSERT_TRUE(r.reliable) << r.reason;
-  ASSERT_TRUE(r.T_target_source_unleveled.has_value());
+  ASSERT_TRUE(r.T_target_source_6dof.has_value());
   // p1 = T_1_2 p2 and p2 = q^-1 p_rolled: the answer must be T_1_2 q^-1.
   Eigen::Matrix4d unroll = Eigen::Matrix4d::Identity();
   unroll.topLeftCorner<3, 3>() = q.inverse().toRotationMatrix();
