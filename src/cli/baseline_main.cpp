@@ -55,8 +55,7 @@ int main(int argc, char** argv) {
       MatchParams params;
       params.grid = p.grid;
       params.threads = p.threads;
-      return report(baseline::matchPaperConsensus(t, s, params), truth, p.grid, {json, method, false},
-                    sizes);
+      return report(baseline::matchPaperConsensus(t, s, params), truth, p.grid, {json, method, false}, sizes);
     }
     const baseline::FpfhResult b = baseline::matchFpfhRansac(t, s, p);
     MatchResult r;

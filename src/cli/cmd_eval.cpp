@@ -38,7 +38,8 @@ struct Row {
   std::string pair, noise, family, method;
   int exit_code = -1;
   bool reliable = false, success = false;
-  double grid = 0, translation_error = NAN, origin_error = NAN, yaw_error = NAN, seconds = 0, cpu_seconds = 0, peak_rss_mb = 0;
+  double grid = 0, translation_error = NAN, origin_error = NAN, yaw_error = NAN, seconds = 0, cpu_seconds = 0,
+         peak_rss_mb = 0;
   double features = 0, slices = 0, payload_bytes = 0, raw_bytes = 0;
   std::string note;
 };
@@ -212,8 +213,7 @@ struct EvalOptions {
 /// The suite a user's own posed sequence stands for: `pairs` seeds of it, tomomap alone.
 Suite sequenceSuite(SuiteSequence q, int pairs) {
   Suite s;
-  if (q.name.empty()) q.name = fs::path(q.scans).lexically_normal().parent_path().filename().string();
-  if (q.name.empty()) q.name = "sequence";
+  if (q.name.empty()) q.name = sequenceName(q.scans);
   s.name = q.name;
   s.methods = {"tomomap"};
   q.seeds.clear();
@@ -345,9 +345,8 @@ int runEval(const EvalOptions& o) {
                                   {"translation_error_m", std::isnan(r.translation_error)
                                                               ? nlohmann::json()
                                                               : nlohmann::json(r.translation_error)},
-                                  {"translation_error_at_origin_m", std::isnan(r.origin_error)
-                                                                        ? nlohmann::json()
-                                                                        : nlohmann::json(r.origin_error)},
+                                  {"translation_error_at_origin_m",
+                                   std::isnan(r.origin_error) ? nlohmann::json() : nlohmann::json(r.origin_error)},
                                   {"yaw_error_rad",
                                    std::isnan(r.yaw_error) ? nlohmann::json() : nlohmann::json(r.yaw_error)},
                                   {"wall_s", r.seconds},

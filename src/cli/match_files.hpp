@@ -24,7 +24,7 @@ struct MatchedFiles {
   MapFeatures target, source;
   MatchResult result;
   std::optional<GroundTruth> truth;  ///< when given
-  nlohmann::json inputs;  ///< for the JSON: each map's path, points, points dropped, stray voxels
+  nlohmann::json inputs;             ///< for the JSON: each map's path, points, points dropped, stray voxels
 };
 
 /// Reads the ground truth first (so a bad pose file fails before minutes of

@@ -45,9 +45,8 @@ GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const GroundTruth
   c.at_origin = miss.topRightCorner<3, 1>().norm();
   double squares = 0;
   for (const auto& p : truth.source_sample) squares += (miss * p.cast<double>().homogeneous()).squaredNorm();
-  c.error.translation = truth.source_sample.empty()
-                            ? c.at_origin
-                            : std::sqrt(squares / static_cast<double>(truth.source_sample.size()));
+  c.error.translation =
+      truth.source_sample.empty() ? c.at_origin : std::sqrt(squares / static_cast<double>(truth.source_sample.size()));
   c.error.yaw =
       Eigen::AngleAxisd(Eigen::Matrix3d(estimate.topLeftCorner<3, 3>().transpose() * expected.topLeftCorner<3, 3>()))
           .angle();
@@ -93,10 +92,11 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
                     *r.dense_second_look_apart);
     out << "tilt             target " << tiltText(r.target_tilt) << ", source " << tiltText(r.source_tilt) << "\n";
     if (r.finish && r.finish->held)
-      out << format("6-DoF finish     corrected %.2f deg of roll and pitch, moved the source %.3f m; %.0f %% of its "
-                    "cells on the target's surfaces (%.0f %% before)\n",
-                    degrees(r.finish->roll_pitch_corrected), r.finish->moved, 100 * r.finish->seen_found_after,
-                    100 * r.finish->seen_found_before);
+      out << format(
+          "6-DoF finish     corrected %.2f deg of roll and pitch, moved the source %.3f m; %.0f %% of its "
+          "cells on the target's surfaces (%.0f %% before)\n",
+          degrees(r.finish->roll_pitch_corrected), r.finish->moved, 100 * r.finish->seen_found_after,
+          100 * r.finish->seen_found_before);
     else if (r.finish)
       out << "6-DoF finish     kept the 4-DoF answer: " << r.finish->why_not << "\n";
     out << format(

@@ -30,7 +30,7 @@ struct GroundTruthCheck {
   /// they belong, rms over the sample [m] (at the origin without one); yaw:
   /// the whole angle between the two rotations [rad].
   PoseError error;
-  double at_origin = 0;  ///< the translation error at the source frame's origin [m]
+  double at_origin = 0;          ///< the translation error at the source frame's origin [m]
   double translation_limit = 0;  ///< 5 x grid [m]
   double yaw_limit = 0;          ///< 10 degrees [rad]
   bool success() const { return error.translation < translation_limit && error.yaw < yaw_limit; }

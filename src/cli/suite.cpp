@@ -75,6 +75,14 @@ void forEachTable(const std::string& file, const toml::table& root, const std::s
 
 }  // namespace
 
+std::string sequenceName(const std::string& scans) {
+  fs::path p = fs::path(scans).lexically_normal();
+  if (p.filename().empty()) p = p.parent_path();  // a trailing slash
+  if (p.filename() == "scans" && p.has_parent_path()) p = p.parent_path();
+  const std::string name = p.filename().string();
+  return name.empty() || name == "." || name == ".." ? "sequence" : name;
+}
+
 Suite loadSuite(const std::string& path) {
   if (!fs::exists(path)) throw InputError(path + ": no such suite file");
   toml::table root;
@@ -166,11 +174,10 @@ Suite loadSuite(const std::string& path) {
       fail(path, t.source(), "[[sequence]] needs 'folder', or 'scans' and 'poses'");
     // A folder as the shared sequences and many SLAM packages lay it out
     // (scans/ and optimized_poses.txt), or the two named apart.
-    const std::string folder = resolve(text(path, t, "folder", "[[sequence]]", ""));
+    const std::string folder = text(path, t, "folder", "[[sequence]]", "");
     q.scans = resolve(text(path, t, "scans", "[[sequence]]", (fs::path(folder) / "scans").string()));
     q.poses = resolve(text(path, t, "poses", "[[sequence]]", (fs::path(folder) / "optimized_poses.txt").string()));
-    q.name = text(path, t, "name", "[[sequence]]",
-                  fs::path(folder.empty() ? q.scans : folder).lexically_normal().filename().string());
+    q.name = text(path, t, "name", "[[sequence]]", sequenceName(q.scans));
     q.seeds = list<int64_t>(path, t, "seeds", q.seeds);
     q.grid = number(path, t, "grid", q.grid);
     if (const toml::node* n = t.get("level")) {

@@ -45,14 +45,18 @@ struct SuiteScan {
 struct SuiteSequence {
   std::string scans;  ///< the folder of keyframe scans (resolved against the suite's folder)
   std::string poses;  ///< their pose file: KITTI, TUM or FAST-LIO's (io/pose_sequence.hpp)
-  std::string name;   ///< family name; default: the sequence folder's name
+  std::string name;   ///< family name; default: sequenceName(scans)
   std::vector<int64_t> seeds{1};
-  double grid = MatchParams{}.grid;  ///< [m]
-  bool level = false;                ///< each map levelled instead of leaning as its SLAM saved it
+  double grid = MatchParams{}.grid;                      ///< [m]
+  bool level = false;                                    ///< each map levelled instead of leaning as its SLAM saved it
   double range = synth::SequencePairParams{}.max_range;  ///< each scan's points kept within [m]
   double move = synth::SequencePairParams{}.move_xy;     ///< the source's largest x, y move [m]
   std::vector<std::string> methods;                      ///< as for [[synth]]
 };
+
+/// A sequence's name from its scans' folder: the folder's, or its parent's
+/// where it is called `scans` (SLAM packages' `NAME/scans` layout).
+std::string sequenceName(const std::string& scans);
 
 /// Every method a suite may name: tomomap, and the baselines it is measured
 /// against (tomomap-baseline --method).

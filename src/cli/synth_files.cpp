@@ -94,7 +94,8 @@ GeneratedWorld writeSequencePair(const std::vector<PosedScan>& scans, const Eige
   const auto& i = pair.info;
   std::ofstream(std::filesystem::path(dir) / "pair.json")
       << nlohmann::json{{"seed", params.seed},
-                        {"keyframes", {{"target", {i.target_first, i.target_last}}, {"source", {i.source_first, i.source_last}}}},
+                        {"keyframes",
+                         {{"target", {i.target_first, i.target_last}}, {"source", {i.source_first, i.source_last}}}},
                         {"overlap", {{"target", i.target_overlap}, {"source", i.source_overlap}}},
                         {"lean_deg", {{"target", degrees(i.target_lean)}, {"source", degrees(i.source_lean)}}},
                         {"levelled", i.level},

@@ -24,8 +24,9 @@ struct Tilt {
   size_t floor_patches = 0;  ///< flat patches facing up (floors, ceilings, ground)
   size_t wall_patches = 0;   ///< flat patches facing sideways (walls)
 
-  /// Whether the estimate is good to level by: its uncertainty within `tolerance`.
-  bool levelable(double tolerance) const { return measured && uncertainty <= tolerance; }
+  /// Whether the estimate is good to level by: measured better than the map
+  /// leans (levelled by it, what is left leans less than the map did).
+  bool levelable() const { return measured && uncertainty < angle; }
   /// Whether the map may lie within `tolerance`: its tilt less its
   /// uncertainty not beyond it (or not measured).
   bool mayBeWithin(double tolerance) const { return !measured || angle - uncertainty <= tolerance; }

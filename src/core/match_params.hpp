@@ -32,7 +32,7 @@ struct MatchParams {
   /// width + height (kSparsestSlice).
   double sparsest_slice = kSparsestSlice;
   /// Level a map tilted beyond max_tilt (turn its up onto z) where the tilt is
-  /// measured well enough (Tilt::levelable), instead of refusing it.
+  /// measured better than it leans (Tilt::levelable), instead of refusing it.
   bool level = true;
   /// Refine a reliable answer in all six degrees of freedom on the maps'
   /// occupancy (six_dof_finish.hpp): the roll and pitch two imperfectly

@@ -110,18 +110,18 @@ void matchSlices(MatchResult& r, FeatureEvidence& e, const MapFeatures& target, 
 std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string& role, const MatchParams& params) {
   const Tilt& tilt = map.tilt;
   if (map.leveled || !tilt.measured || tilt.angle <= params.max_tilt) return std::nullopt;
-  // An estimate too uncertain to level by that may still lie within the
-  // tolerance is matched as it is: thinned or noisy LiDAR crops whose ground
-  // lies 1.5-2.3 deg off read 3.5-9.4 +- 1.0-2.3 deg (5 of 639 real-scan pairs).
-  if (tilt.angle <= kMaxLevelable && tilt.mayBeWithin(params.max_tilt)) return std::nullopt;
+  // Levelling on, a map within the levelling limit that was not levelled
+  // was not measured better than it leans: it is matched as it is (thinned
+  // or noisy LiDAR crops whose ground lies 1.5-2.3 deg off read 3.5-9.4 deg,
+  // their halves disagreeing by as much). Levelling off (the daemon), only a
+  // map surely beyond the tolerance is refused.
+  if (params.level ? tilt.angle <= kMaxLevelable : tilt.mayBeWithin(params.max_tilt)) return std::nullopt;
   const std::string tilted = role + " map is tilted " + fixed(degrees(tilt.angle), 1) + " +- " +
                              fixed(degrees(tilt.uncertainty), 1) + " deg from gravity (matched as it is up to " +
                              fixed(degrees(params.max_tilt), 1) + " deg)";
   if (!params.level) return tilted + "; levelling is off: level the map first";
-  if (tilt.angle > kMaxLevelable)
-    return tilted + ", too far to level (limit " + fixed(degrees(kMaxLevelable), 0) +
-           " deg): its axes may be swapped (y up); fix its frame";
-  return tilted + ", not measured well enough to level (its flat surfaces disagree): level it by its IMU first";
+  return tilted + ", too far to level (limit " + fixed(degrees(kMaxLevelable), 0) +
+         " deg): its axes may be swapped (y up); fix its frame, or give its up (--up-target, --up-source)";
 }
 
 MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings, size_t* filtered_points,
@@ -134,9 +134,8 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   // points alone, and took as long as both on a street): the map is sliced
   // before the tilt is known, and sliced again in the rare case it is levelled.
   // From the raw points: the filter's grid would bias a leaning plane's normals towards the axes.
-  std::future<Tilt> tilt_estimate =
-      std::async(threads > 1 && !up ? std::launch::async : std::launch::deferred,
-                 [&] { return up ? givenTilt(*up) : estimateTilt(map, params.grid); });
+  std::future<Tilt> tilt_estimate = std::async(threads > 1 && !up ? std::launch::async : std::launch::deferred,
+                                               [&] { return up ? givenTilt(*up) : estimateTilt(map, params.grid); });
   auto t0 = Clock::now();
   Eigen::Vector3f corner = previous ? previous->voxel_corner : Eigen::Vector3f::Constant(NAN);
   Points filtered = voxelFilter(map, params.grid, &corner);
@@ -151,7 +150,7 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   const bool known = tilt.cue == Tilt::Cue::given;
   const bool level = params.level && (known ? tilt.angle > 0.0
                                             : tilt.angle > params.max_tilt && tilt.angle <= kMaxLevelable &&
-                                                  tilt.levelable(params.max_tilt));
+                                                  tilt.levelable());
   if (level) {
     // The levelled map is filtered again: rotated voxels no longer sit on the grid.
     filtered = voxelFilter(rotatePoints(filtered, tilt.leveling()), params.grid);

@@ -5,7 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <sstream>
+
+#include "text.hpp"
 
 namespace tomomap {
 namespace {
@@ -124,7 +125,9 @@ struct Target {
   LatticeIndex columns;  ///< (u, v) of every column with a cell in some slice: where the target saw anything
   /// Steps out to the widest radius plus the half diagonal a position may sit off its cell.
   std::vector<Offset> search;
-  std::vector<Plane> planes;  ///< one per cell
+  std::vector<Plane> planes;  ///< one per cell, fitted where a correspondence first needs it (fitted)
+  std::vector<uint8_t> fitted;
+  double normal_radius = 0, planarity = 0;  ///< SixDofFinishParams' [cells], [ratio]
 };
 
 std::vector<LatticeCell> columnsOf(const std::vector<LatticeCell>& cells) {
@@ -138,33 +141,41 @@ std::vector<LatticeCell> columnsOf(const std::vector<LatticeCell>& cells) {
 /// crossing the radius-2 ball holds about 13).
 constexpr int kMinPlaneCells = 6;
 
-std::vector<Plane> fitPlanes(const Target& t, double radius_cells, double planarity, int threads) {
-  const std::vector<Offset> near = offsetsWithin(radius_cells);
-  std::vector<Plane> planes(t.cells.size());
+/// Fits the planes of target cells `needed` that have none yet: a plane is
+/// fitted only where a correspondence needs it (a map of 700,000 cells at
+/// 5 cm uses a few tens of thousands), each the same whenever it is fitted.
+void fitPlanes(Target& t, const std::vector<int64_t>& needed, int threads) {
+  std::vector<size_t> todo;
+  for (int64_t j : needed)
+    if (j >= 0 && !t.fitted[static_cast<size_t>(j)]) {
+      t.fitted[static_cast<size_t>(j)] = 1;
+      todo.push_back(static_cast<size_t>(j));
+    }
+  const std::vector<Offset> near = offsetsWithin(t.normal_radius);
 #pragma omp parallel for schedule(static) num_threads(threads)
-  for (size_t i = 0; i < t.cells.size(); ++i) {
+  for (size_t n = 0; n < todo.size(); ++n) {
+    const size_t i = todo[n];
     const LatticeCell& c = t.cells[i];
     // In lattice units (the cells are cubes): the offsets are exact integers.
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-    int n = 0;
+    int count = 0;
     for (const Offset& o : near) {
       if (t.index.find(c.u + o.du, c.v + o.dv, c.k + o.dk) < 0) continue;
       const Eigen::Vector3d d(o.du, o.dv, o.dk);
       sum += d;
       outer += d * d.transpose();
-      ++n;
+      ++count;
     }
-    if (n < kMinPlaneCells) continue;
-    const Eigen::Vector3d mean = sum / n;
+    if (count < kMinPlaneCells) continue;
+    const Eigen::Vector3d mean = sum / count;
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(outer / n - mean * mean.transpose());
+    eig.computeDirect(outer / count - mean * mean.transpose());
     const Eigen::Vector3d l = eig.eigenvalues();  // ascending
-    if (!(l(0) <= planarity * l(1))) continue;    // a corner, an edge, clutter: no one normal
-    planes[i].point = centreOf(t.grid, c) + t.grid.cell * mean;
-    planes[i].normal = eig.eigenvectors().col(0).normalized();
+    if (!(l(0) <= t.planarity * l(1))) continue;  // a corner, an edge, clutter: no one normal
+    t.planes[i].point = centreOf(t.grid, c) + t.grid.cell * mean;
+    t.planes[i].normal = eig.eigenvectors().col(0).normalized();
   }
-  return planes;
 }
 
 /// The occupied target cell nearest to lattice position f within `radius`
@@ -231,11 +242,15 @@ constexpr size_t kChunks = 64;
 /// `pivot` (the source cells' centroid in the target frame, scaled by `lever`,
 /// their rms distance from it, so that all six are in metres and the system is
 /// well conditioned far from the origin) and a shift.
-Sweep sweep(const Target& t, const std::vector<Eigen::Vector3d>& source, const Eigen::Matrix4d& T, double radius,
+Sweep sweep(Target& t, const std::vector<Eigen::Vector3d>& source, const Eigen::Matrix4d& T, double radius,
             double kernel, const Eigen::Vector3d& pivot, double lever, int threads) {
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
   const Eigen::Vector3d shift = T.topRightCorner<3, 1>();
   const double kernel2 = kernel * kernel;
+  std::vector<int64_t> nearest(source.size());
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (size_t i = 0; i < source.size(); ++i) nearest[i] = nearestCell(t, latticeOf(t.grid, R * source[i] + shift), radius);
+  fitPlanes(t, nearest, threads);
   std::vector<Sweep> chunks(kChunks);
   const size_t per_chunk = (source.size() + kChunks - 1) / kChunks;
 #pragma omp parallel for schedule(dynamic) num_threads(threads)
@@ -248,7 +263,7 @@ Sweep sweep(const Target& t, const std::vector<Eigen::Vector3d>& source, const E
           std::abs(f.x()) < 1e9 && std::abs(f.y()) < 1e9 &&
           t.columns.find(static_cast<int>(std::lround(f.x())), static_cast<int>(std::lround(f.y())), 0) >= 0;
       s.seen += seen;
-      const int64_t j = nearestCell(t, f, radius);
+      const int64_t j = nearest[i];
       if (j < 0) continue;
       const Plane& plane = t.planes[static_cast<size_t>(j)];
       if (plane.normal.isZero()) continue;
@@ -283,14 +298,6 @@ double turnBetween(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
   return Eigen::AngleAxisd(a.transpose() * b).angle();
 }
 
-std::string figure(double v, int precision = 2) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(precision);
-  s << v;
-  return s.str();
-}
-
 }  // namespace
 
 SixDofFinish finishSixDof(const SliceStack& target, const SliceStack& source, const Eigen::Matrix4d& T_start,
@@ -320,8 +327,10 @@ SixDofFinish finishSixDof(const SliceStack& target, const SliceStack& source, co
            LatticeIndex(target.grid, target.size(), cells),
            LatticeIndex(target.grid, 1, columnsOf(cells)),
            offsetsWithin(widest + std::sqrt(3.0) / 2),
-           {}};
-  t.planes = fitPlanes(t, params.normal_radius_cells, params.planarity, params.threads);
+           std::vector<Plane>(cells.size()),
+           std::vector<uint8_t>(cells.size(), 0),
+           params.normal_radius_cells,
+           params.planarity};
 
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const auto& p : points) centroid += p;
@@ -339,13 +348,13 @@ SixDofFinish finishSixDof(const SliceStack& target, const SliceStack& source, co
   result.rms_before = before.rms();
   result.seen_found_before = before.seenShare();
   const auto share = [&](size_t n) {
-    return figure(100.0 * static_cast<double>(n) / static_cast<double>(points.size()), 1) + " %";
+    return fixed(100.0 * static_cast<double>(n) / static_cast<double>(points.size()), 1) + " %";
   };
   const double least = params.min_overlap * static_cast<double>(points.size());
   if (static_cast<double>(before.inliers) < least) {
     result.why_not = "too little overlap at the start: " + std::to_string(before.inliers) + " of " +
                      std::to_string(points.size()) + " cells (" + share(before.inliers) + ") within " +
-                     figure(last_radius, 1) + " cells of a target plane, need " + figure(100 * params.min_overlap, 0) +
+                     fixed(last_radius, 1) + " cells of a target plane, need " + fixed(100 * params.min_overlap, 0) +
                      " %";
     return result;
   }
@@ -364,11 +373,24 @@ SixDofFinish finishSixDof(const SliceStack& target, const SliceStack& source, co
       const Sweep s = sweep(t, points, T, radius, params.kernel_share * radius * cell, pivot, lever, params.threads);
       ++result.iterations;
       if (s.inliers < 6) {
-        result.why_not = "diverged: " + std::to_string(s.inliers) + " cells within " + figure(radius, 1) +
-                         " cells of a target plane";
+        result.why_not =
+            "diverged: " + std::to_string(s.inliers) + " cells within " + fixed(radius, 1) + " cells of a target plane";
         return result;
       }
-      const Vector6d x = -(s.H + kDamping * s.weights * Matrix6d::Identity()).ldlt().solve(s.g);
+      Vector6d x = -(s.H + kDamping * s.weights * Matrix6d::Identity()).ldlt().solve(s.g);
+      // Directions the surfaces hardly fix (a street's length between its
+      // facades) are left where the 4-DoF answer put them: the cells' small
+      // pulls along them are the maps' own distortions, not the pose.
+      // (Degeneracy-aware solving: the step projected onto the eigenvectors
+      // of the system that the data constrain.)
+      {
+        Eigen::SelfAdjointEigenSolver<Matrix6d> eig(s.H);
+        const Vector6d l = eig.eigenvalues();
+        Vector6d keep = Vector6d::Zero();
+        for (int d = 0; d < 6; ++d) keep(d) = l(d) >= params.min_constraint * l(5) ? 1.0 : 0.0;
+        const Matrix6d V = eig.eigenvectors();
+        x = V * keep.asDiagonal() * V.transpose() * x;
+      }
       if (!x.allFinite()) {
         result.why_not = "diverged: the 6x6 system has no solution";
         return result;
@@ -392,14 +414,15 @@ SixDofFinish finishSixDof(const SliceStack& target, const SliceStack& source, co
   result.moved = moved / static_cast<double>(points.size());
   const double turned = turnBetween(R0, R);
   if (!converged && last_step > 0.1 * cell) {
-    result.why_not = "diverged: still moving the cells " + figure(last_step / cell) + " cells an iteration after " +
+    result.why_not = "diverged: still moving the cells " + fixed(last_step / cell, 2) + " cells an iteration after " +
                      std::to_string(result.iterations) + " iterations";
     return result;
   }
   if (result.moved > params.max_move_cells * cell || turned > params.max_turn) {
-    result.why_not = "diverged: it moved the cells " + figure(result.moved) + " m on average and turned " +
-                     figure(degrees(turned)) + " deg; a finish moves at most " + figure(params.max_move_cells * cell) +
-                     " m and turns " + figure(degrees(params.max_turn)) + " deg";
+    result.why_not = "diverged: it moved the cells " + fixed(result.moved, 2) + " m on average and turned " +
+                     fixed(degrees(turned), 2) + " deg; a finish moves at most " +
+                     fixed(params.max_move_cells * cell, 2) + " m and turns " + fixed(degrees(params.max_turn), 2) +
+                     " deg";
     return result;
   }
   const Sweep after = judge(T);
@@ -413,8 +436,8 @@ SixDofFinish finishSixDof(const SliceStack& target, const SliceStack& source, co
   // robot saw from a side the other did not), generated rooms 0.93; the
   // verdict judged the pose, the finish only sharpens it.
   if (result.seen_found_after < result.seen_found_before - params.seen_found_noise) {
-    result.why_not = "the fit got worse: " + figure(100 * result.seen_found_before, 1) + " -> " +
-                     figure(100 * result.seen_found_after, 1) +
+    result.why_not = "the fit got worse: " + fixed(100 * result.seen_found_before, 1) + " -> " +
+                     fixed(100 * result.seen_found_after, 1) +
                      " % of the cells landing where the target saw anything lie on its surfaces";
     return result;
   }

@@ -57,8 +57,8 @@ ScanPair makeScanPair(const Points& scan, const ScanPairParams& params) {
   pair.source.points = transformPoints(crop(false, !info.target_degraded), info.move);
   if (pair.target.points.size() < kMinPointsPerCrop || pair.source.points.size() < kMinPointsPerCrop)
     throw SmallCrop("cutting this scan left a crop of " +
-                     std::to_string(std::min(pair.target.points.size(), pair.source.points.size())) +
-                     " points (at least " + std::to_string(kMinPointsPerCrop) + ")");
+                    std::to_string(std::min(pair.target.points.size(), pair.source.points.size())) +
+                    " points (at least " + std::to_string(kMinPointsPerCrop) + ")");
   // The scan's frame is the world: the target stays in it, the source is moved.
   pair.target.pose = Eigen::Matrix4d::Identity();
   pair.source.pose = info.move.matrix();

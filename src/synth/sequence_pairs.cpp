@@ -86,16 +86,19 @@ SequencePair makeSequencePair(const std::vector<PosedScan>& scans, const Eigen::
                               const SequencePairParams& params) {
   const size_t n = scans.size();
   if (n < kMinKeyframes)
-    throw InputError("a sequence of " + std::to_string(n) + " keyframes is too short to cut into two robots' maps (at least " +
-                     std::to_string(kMinKeyframes) + ")");
+    throw InputError("a sequence of " + std::to_string(n) +
+                     " keyframes is too short to cut into two robots' maps (at least " + std::to_string(kMinKeyframes) +
+                     ")");
   std::mt19937_64 rng(params.seed * 0x9E3779B97F4A7C15ull + 7);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   const auto draw = [&](double lo, double hi) { return lo + (hi - lo) * unit(rng); };
 
   // Two windows of `w` keyframes sharing `shared` of them, placed at random
   // along the sequence; which robot walked first is drawn too.
-  const auto w = std::clamp<size_t>(static_cast<size_t>(std::lround(draw(params.min_window, params.max_window) * static_cast<double>(n))), 2, n);
-  const auto shared = std::min(w - 1, static_cast<size_t>(std::lround(draw(params.min_shared, params.max_shared) * static_cast<double>(w))));
+  const auto w = std::clamp<size_t>(
+      static_cast<size_t>(std::lround(draw(params.min_window, params.max_window) * static_cast<double>(n))), 2, n);
+  const auto shared = std::min(
+      w - 1, static_cast<size_t>(std::lround(draw(params.min_shared, params.max_shared) * static_cast<double>(w))));
   const size_t span = std::min(n, 2 * w - shared);
   const auto first = static_cast<size_t>(std::floor(unit(rng) * static_cast<double>(n - span + 1)));
   size_t a0 = first, a1 = first + w - 1, b0 = first + span - w, b1 = first + span - 1;

@@ -93,7 +93,7 @@ TEST(GravityStability, ThinningAndCroppingMoveTheTiltByLessThanItsStatedUncertai
           << what << ": its up lies " << degrees(moved) << " deg from the whole map's, which reads "
           << degrees(whole.angle) << " +- " << degrees(whole.uncertainty);
     }
-    std::cout << m.name << ": " << degrees(whole.angle) << " +- " << degrees(whole.uncertainty) << " deg, "
-              << checked << " of " << parts.size() << " parts checked it\n";
+    std::cout << m.name << ": " << degrees(whole.angle) << " +- " << degrees(whole.uncertainty) << " deg, " << checked
+              << " of " << parts.size() << " parts checked it\n";
   }
 }

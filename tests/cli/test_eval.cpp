@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -211,4 +213,80 @@ TEST(Eval, ARunPastTheTimeoutIsKilledAndSaysSoAndTheSuiteGoesOn) {
   EXPECT_EQ(rows[0]["note"], "timed out after 0.5 s");
   EXPECT_FALSE(rows[0]["success"].get<bool>());
   EXPECT_EQ(rows[1]["method"], "tomomap") << "the next run still ran";
+}
+
+// A user's own SLAM output, as the SLAM saved it: a folder of keyframe scans
+// in the sensor's frame and a KITTI pose file, the sensor leaning 5 degrees.
+// `tomomap eval --scans --poses` cuts two robots' maps from it, each leaning
+// as its first keyframe did, and says how tomomap does on them.
+TEST(Eval, APosedSequenceOfAUsersScansIsCutIntoPairsAndJudged) {
+  TempDir dir;
+  const auto gen = runTomomap("synth -w room -s 3 --noise none -o " + (dir / "room"));
+  ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  const Points world = loadMap(dir / "room/map_0.pcd");
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(INFINITY), hi = -lo;
+  for (const auto& p : world) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  std::filesystem::create_directories(dir / "scans");
+  std::ofstream poses(dir / "optimized_poses.txt");
+  const int keyframes = 24;
+  for (int k = 0; k < keyframes; ++k) {
+    // Along the room's length at mid height, leaning 5 degrees and turning as it goes.
+    const float s = static_cast<float>(k) / (keyframes - 1);
+    Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+    T.topLeftCorner<3, 3>() = (Eigen::AngleAxisd(0.3 * k, Eigen::Vector3d::UnitZ()) *
+                               Eigen::AngleAxisd(radians(5.0), Eigen::Vector3d::UnitX()))
+                                  .toRotationMatrix();
+    T.topRightCorner<3, 1>() = Eigen::Vector3f(lo.x() + (0.2f + 0.6f * s) * (hi.x() - lo.x()), 0.5f * (lo.y() + hi.y()),
+                                               0.5f * (lo.z() + hi.z()))
+                                   .cast<double>();
+    const Eigen::Matrix4d body_world = T.inverse();
+    Points scan;
+    for (const auto& p : world)
+      if ((p.cast<double>() - T.topRightCorner<3, 1>()).norm() < 3.0)
+        scan.push_back((body_world * p.cast<double>().homogeneous()).head<3>().cast<float>());
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d.pcd", k);
+    savePcd((std::filesystem::path(dir / "scans") / name).string(), scan);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 4; ++c) poses << T(r, c) << (r == 2 && c == 3 ? "\n" : " ");
+  }
+  poses.close();
+  const auto r = runTomomap("eval --scans " + (dir / "scans") + " --poses " + (dir / "optimized_poses.txt") +
+                            " --grid 0.1 --pairs 2 --range 10 -o " + (dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string md = slurp(dir / "out/summary.md");
+  // The family is named after the scans' folder, with the grid and how the maps lie.
+  const std::regex row(R"(\| tomomap \| [^|]* g0.1 leaning \| 2 \| ([0-9]) \| ([0-9]) \| ([0-9]) \| ([0-9]) \|)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(md, m, row)) << md;
+  EXPECT_EQ(std::stoi(m[4]), 0) << "no run failed to run\n" << md;
+  EXPECT_EQ(std::stoi(m[3]), 0) << "no answer wrong\n" << md;
+  size_t pairs = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "out/worlds")) {
+    const auto pair = nlohmann::json::parse(slurp((e.path() / "pair.json").string()));
+    ++pairs;
+    EXPECT_NEAR(pair["lean_deg"]["target"].get<double>(), 5.0, 0.5) << pair.dump(2);
+    EXPECT_NEAR(pair["lean_deg"]["source"].get<double>(), 5.0, 0.5) << pair.dump(2);
+    EXPECT_GT(pair["overlap"]["target"].get<double>(), 0.0) << pair.dump(2);
+  }
+  EXPECT_EQ(pairs, 2u);
+  // The same sequence from a suite, by a folder relative to the suite file
+  // that holds scans/ and optimized_poses.txt, levelled.
+  const auto suite = evalSuite(dir,
+                               "name = \"mine\"\nmethods = [\"tomomap\"]\n[[sequence]]\nfolder = \".\"\n"
+                               "seeds = [1]\ngrid = 0.1\nrange = 10\nlevel = true\n");
+  ASSERT_EQ(suite.exit_code, 0) << suite.output;
+  const auto rows = jsonRows(dir);
+  ASSERT_EQ(rows.size(), 1u) << suite.output;
+  EXPECT_NE(rows[0]["family"].get<std::string>().find(" g0.1 levelled"), std::string::npos) << rows[0].dump();
+  EXPECT_NE(rows[0]["exit_code"].get<int>(), 2) << rows[0].dump();
+  // A pose file that does not fit its scans is refused, saying both counts.
+  std::ofstream(dir / "short.txt") << "1 0 0 0 0 1 0 0 0 0 1 0\n";
+  const auto bad =
+      runTomomap("eval --scans " + (dir / "scans") + " --poses " + (dir / "short.txt") + " -o " + (dir / "bad"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("24 scans, but"), std::string::npos) << bad.output;
 }

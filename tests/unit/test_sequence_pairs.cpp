@@ -92,7 +92,8 @@ TEST(SequencePairs, TheGroundTruthPutsEveryPointBackAndMapsLeanAsTheirFirstKeyfr
       EXPECT_LT(offTheHall(pair.source), 0.05);
       EXPECT_NEAR(degrees(i.target_lean), level ? 0.0 : 6.0, 0.3);
       EXPECT_NEAR(degrees(i.source_lean), level ? 0.0 : 6.0, 0.3);
-      if (level) {  // the floor lies at one height in a levelled map: its lowest points span a voxel (the walls' feet add a few)
+      if (level) {  // the floor lies at one height in a levelled map: its lowest points span a voxel (the walls' feet
+                    // add a few)
         float lowest = INFINITY;
         for (const auto& p : pair.target.points) lowest = std::min(lowest, p.z());
         size_t floor = 0, near_floor = 0;
