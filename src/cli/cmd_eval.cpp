@@ -229,7 +229,10 @@ int runEval(const EvalOptions& o) {
   Suite suite = o.suite.empty() ? sequenceSuite(o.sequence, o.sequence_pairs) : loadSuite(o.suite);
   if (!o.methods.empty()) {
     suite.methods = o.methods;
-    for (auto& y : suite.synth) y.methods.clear();  // the command line decides for every pair
+    // The command line decides for every pair.
+    for (auto& y : suite.synth) y.methods.clear();
+    for (auto& c : suite.scans) c.methods.clear();
+    for (auto& q : suite.sequences) q.methods.clear();
   }
   for (const auto& w : suite.warnings) std::cerr << "tomomap eval: warning: " << w << "\n";
   const fs::path out(o.out);
@@ -301,7 +304,17 @@ int runEval(const EvalOptions& o) {
         scans = loadPosedScans(q.scans, q.poses);
       }
       const auto up_key = std::make_tuple(q.scans, q.poses, q.range);
-      if (!ups.count(up_key)) ups[up_key] = synth::sequenceUp(scans, params);
+      // Leaning maps need the up only to say how far they lean: a sequence
+      // whose floors do not tell it is still cut, its leans unknown (null).
+      if (!ups.count(up_key)) try {
+          ups[up_key] = synth::sequenceUp(scans, params);
+        } catch (const InputError&) {
+          ups[up_key] = Eigen::Vector3d::Constant(NAN);
+        }
+      if (q.level && !ups[up_key].allFinite())
+        throw InputError(q.scans +
+                         ": the sequence's flat surfaces do not tell its up direction: its maps cannot be "
+                         "levelled (level = false cuts them as they lean)");
       const std::string variant = q.level ? "level" : "lean";
       const std::string folder = q.name + "-" + std::to_string(seed) + "-g" + shortNumber(q.grid) + "-" + variant;
       std::cerr << "cutting " << folder << "\n";

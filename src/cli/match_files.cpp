@@ -74,6 +74,9 @@ MatchedFiles matchFiles(MatchFilesOptions o) {
   params.max_tilt = radians(o.max_tilt_deg);
   requireBothOrNeither(o.gt_target, o.gt_source);
   MatchedFiles m;
+  for (const auto& [name, up] : {std::pair{"--up-target", &o.up_target}, std::pair{"--up-source", &o.up_source}})
+    if (const auto v = upOf(*up); v && !(v->allFinite() && v->norm() > 0))
+      throw InputError(std::string(name) + " must be a non-zero direction X,Y,Z");
   if (!o.gt_target.empty()) m.truth = GroundTruth{loadPoseFile(o.gt_target), loadPoseFile(o.gt_source), {}};
   Points* sample = m.truth ? &m.truth->source_sample : nullptr;
 

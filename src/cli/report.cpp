@@ -66,7 +66,7 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
                  const std::string& method) {
   out << resultLine(r) << "\n";
   if (r.reliable) {
-    if (r.T_target_source_6dof) out << "  its x, y, z and yaw; the whole transform between the maps' own frames:\n";
+    if (r.T_target_source_6dof) out << "  its 4-DoF part; the whole transform between the maps' own frames:\n";
     const Eigen::Matrix4d M = r.matrix();
     for (int i = 0; i < 4; ++i) out << format("  [%9.5f %9.5f %9.5f %9.4f]\n", M(i, 0), M(i, 1), M(i, 2), M(i, 3));
   }

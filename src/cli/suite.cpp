@@ -76,7 +76,7 @@ void forEachTable(const std::string& file, const toml::table& root, const std::s
 }  // namespace
 
 std::string sequenceName(const std::string& scans) {
-  fs::path p = fs::path(scans).lexically_normal();
+  fs::path p = fs::absolute(scans).lexically_normal();
   if (p.filename().empty()) p = p.parent_path();  // a trailing slash
   if (p.filename() == "scans" && p.has_parent_path()) p = p.parent_path();
   const std::string name = p.filename().string();

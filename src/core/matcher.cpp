@@ -44,6 +44,25 @@ Eigen::Matrix4d unleveled(const Eigen::Matrix4d& T, const MapFeatures& target, c
   return rotation(target).inverse() * T * rotation(source);
 }
 
+/// The middle of a map's occupancy [m]: its raster's centre, halfway up its slices.
+Eigen::Vector3d occupancyCentre(const SliceStack& s) {
+  const Eigen::Vector2d c = s.grid.centre();
+  return {c.x(), c.y(), s.grid.sliceHeight(s.size() / 2)};
+}
+
+/// The 4-DoF transform nearest `T` at `c`: T's yaw, and c moved where T moves
+/// it. About the origin instead, the roll and pitch T leaves out would move
+/// points far from it (2.8 deg is 1.5 m at 30 m).
+Pose4 fourDofAbout(const Eigen::Matrix4d& T, const Eigen::Vector3d& c) {
+  Pose4 p = Pose4::fromMatrix(T);
+  const Eigen::Vector3d at = T.topLeftCorner<3, 3>() * c + T.topRightCorner<3, 1>();
+  const double cy = std::cos(p.yaw), sy = std::sin(p.yaw);
+  p.x = at.x() - (cy * c.x() - sy * c.y());
+  p.y = at.y() - (sy * c.x() + cy * c.y());
+  p.z = at.z() - c.z();
+  return p;
+}
+
 /// The tomographic match of two maps' feature stacks: its figures into `r`,
 /// what the verdict weighs of them into `e`.
 void matchSlices(MatchResult& r, FeatureEvidence& e, const MapFeatures& target, const MapFeatures& source,
@@ -115,11 +134,11 @@ std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string
   // or noisy LiDAR crops whose ground lies 1.5-2.3 deg off read 3.5-9.4 deg,
   // their halves disagreeing by as much). Levelling off (the daemon), only a
   // map surely beyond the tolerance is refused.
-  if (params.level ? tilt.angle <= kMaxLevelable : tilt.mayBeWithin(params.max_tilt)) return std::nullopt;
+  if (tilt.angle <= kMaxLevelable && (params.level || tilt.mayBeWithin(params.max_tilt))) return std::nullopt;
   const std::string tilted = role + " map is tilted " + fixed(degrees(tilt.angle), 1) + " +- " +
                              fixed(degrees(tilt.uncertainty), 1) + " deg from gravity (matched as it is up to " +
                              fixed(degrees(params.max_tilt), 1) + " deg)";
-  if (!params.level) return tilted + "; levelling is off: level the map first";
+  if (!params.level && tilt.angle <= kMaxLevelable) return tilted + "; levelling is off: level the map first";
   return tilted + ", too far to level (limit " + fixed(degrees(kMaxLevelable), 0) +
          " deg): its axes may be swapped (y up); fix its frame, or give its up (--up-target, --up-source)";
 }
@@ -148,9 +167,9 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   // own error (0.6 deg on demo-pcd1) cost 3 cm and 0.6 deg on demo-room. A
   // known up has no error: the map is levelled by whatever it leans.
   const bool known = tilt.cue == Tilt::Cue::given;
-  const bool level = params.level && (known ? tilt.angle > 0.0
-                                            : tilt.angle > params.max_tilt && tilt.angle <= kMaxLevelable &&
-                                                  tilt.levelable());
+  const bool level =
+      params.level &&
+      (known ? tilt.angle > 0.0 : tilt.angle > params.max_tilt && tilt.angle <= kMaxLevelable && tilt.levelable());
   if (level) {
     // The levelled map is filtered again: rotated voxels no longer sit on the grid.
     filtered = voxelFilter(rotatePoints(filtered, tilt.leveling()), params.grid);
@@ -205,7 +224,7 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
     r.timings.finish = secondsSince(t0);
     if (r.finish->held) {
       answer = r.finish->T_target_source;
-      r.T_target_source = Pose4::fromMatrix(answer);
+      r.T_target_source = fourDofAbout(answer, occupancyCentre(source.occupancy));
     }
   }
   if (target.leveled || source.leveled || (r.finish && r.finish->held))

@@ -39,7 +39,9 @@ struct MatchResult {
   bool reliable = false;
   std::string reason;
   /// p_target = T_target_source * p_source (between the levelled frames, if
-  /// levelled): the 4-DoF answer, or the x, y, z and yaw of the 6-DoF finish where it held.
+  /// levelled): the 4-DoF answer, or, where the 6-DoF finish held, the 4-DoF
+  /// transform nearest it at the source map's centre (its yaw, and the centre
+  /// moved where it moves it).
   Pose4 T_target_source;
   /// The whole transform between the maps' own frames, where it is not 4-DoF:
   /// a map was levelled (its levelling included), or the 6-DoF finish held

@@ -38,7 +38,7 @@ struct SixDofFinishParams {
   /// [rad] is refused. The 4-DoF answer is 0.3-0.7 m off (3-7 cells at 0.1 m)
   /// and the residual roll and pitch 0.5-3 degrees, plus about a degree of yaw.
   double max_move_cells = 8.0;
-  double max_turn = 0.0872664626;  // 5 degrees
+  double max_turn = radians(5.0);
   /// Fewer inliers than this share of the source cells used, at the start or at
   /// the end, is too little overlap to judge the result by [ratio].
   double min_overlap = 0.1;

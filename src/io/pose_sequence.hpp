@@ -16,8 +16,10 @@ namespace tomomap {
 std::vector<Eigen::Matrix4d> loadPoseSequence(const std::string& path);
 
 /// The keyframe scans of `scans_dir` (every .pcd, .ply or .xyz file, in name
-/// order: SLAM packages number them), posed by `pose_file` (one pose a
-/// scan). Throws InputError when the counts differ or a scan cannot be read.
+/// order with numbers as numbers: SLAM packages number them, padded or not),
+/// posed by `pose_file` (one pose a scan, T_world_scan for the scan's own
+/// frame: KITTI's published poses are the left camera's, not the LiDAR's).
+/// Throws InputError when the counts differ or a scan cannot be read.
 std::vector<PosedScan> loadPosedScans(const std::string& scans_dir, const std::string& pose_file);
 
 }  // namespace tomomap

@@ -288,5 +288,5 @@ TEST(Eval, APosedSequenceOfAUsersScansIsCutIntoPairsAndJudged) {
   const auto bad =
       runTomomap("eval --scans " + (dir / "scans") + " --poses " + (dir / "short.txt") + " -o " + (dir / "bad"));
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
-  EXPECT_NE(bad.output.find("24 scans, but"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("24 scans (.pcd, .ply, .xyz), but"), std::string::npos) << bad.output;
 }

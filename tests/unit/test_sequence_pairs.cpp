@@ -90,6 +90,23 @@ TEST(SequencePairs, TheGroundTruthPutsEveryPointBackAndMapsLeanAsTheirFirstKeyfr
       // A voxel's centre lies within half a cube's diagonal of the surface.
       EXPECT_LT(offTheHall(pair.target), 0.05);
       EXPECT_LT(offTheHall(pair.source), 0.05);
+      // Each map's frame is its first keyframe's: as saved (leaning), or at its
+      // place and yaw with z up (levelled).
+      const Eigen::Matrix4d first = pair.target.pose * scans[i.target_first].T_world_body;
+      const Eigen::Matrix4d source_first = scans[i.source_first].T_world_body;
+      EXPECT_LT((first.topRightCorner<3, 1>().norm()), 1e-9) << "the first keyframe sits at the map's origin";
+      if (!level) {
+        EXPECT_TRUE(first.isIdentity(1e-9)) << first;
+      }
+      const Eigen::Vector3d up_in_map = pair.target.pose.topLeftCorner<3, 3>() * up;
+      if (level) {
+        EXPECT_NEAR(up_in_map.z(), 1.0, 1e-9);
+      }
+      // The source: its first keyframe at the move's translation, turned by its yaw.
+      const Eigen::Matrix4d moved = pair.source.pose * source_first;
+      EXPECT_NEAR(moved(0, 3), i.move.x, 1e-9);
+      EXPECT_NEAR(moved(1, 3), i.move.y, 1e-9);
+      EXPECT_NEAR(moved(2, 3), i.move.z, 1e-9);
       EXPECT_NEAR(degrees(i.target_lean), level ? 0.0 : 6.0, 0.3);
       EXPECT_NEAR(degrees(i.source_lean), level ? 0.0 : 6.0, 0.3);
       if (level) {  // the floor lies at one height in a levelled map: its lowest points span a voxel (the walls' feet
