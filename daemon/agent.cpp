@@ -29,9 +29,8 @@ void Agent::post(std::function<void()> work) {
 namespace {
 
 std::string tiltText(const MapFeatures& f) {
-  return f.tilt.measured
-             ? "tilt " + fixed(degrees(f.tilt.angle), 1) + " +- " + fixed(degrees(f.tilt.uncertainty), 1) + " deg"
-             : "tilt not measurable (too few flat surfaces)";
+  if (!f.tilt.measured) return "tilt not measurable (too few flat surfaces)";
+  return std::string(f.leveled ? "levelled: it leaned " : "tilt ") + leanText(f.tilt);
 }
 
 }  // namespace
@@ -52,8 +51,8 @@ OwnMap describeLoaded(const Config& config, OwnMap own, const std::function<Poin
   auto features = [&] {
     const Points map = load(own);  // dropped once described
     const auto loaded = Clock::now();
-    auto described = std::make_shared<MapFeatures>(
-        describeMap(map, config.match, &own.stages, &own.cells, alike ? before.features.get() : nullptr));
+    auto described = std::make_shared<MapFeatures>(describeMap(map, config.match, &own.stages, &own.cells,
+                                                               alike ? before.features.get() : nullptr, config.map_up));
     own.stages.load = seconds(loaded - t0);
     return described;
   }();

@@ -59,6 +59,10 @@ void Agent::writeStatus(bool retry_outputs) {
           {"waiting", !offering()},
           {"tilt_deg", offering() && own_features_->tilt.measured ? nlohmann::json(degrees(own_features_->tilt.angle))
                                                                   : nlohmann::json()},
+          {"levelled", offering() && own_features_->leveled},
+          {"up", offering() ? nlohmann::json{own_features_->slicedUp().x(), own_features_->slicedUp().y(),
+                                             own_features_->slicedUp().z()}
+                            : nlohmann::json()},
           {"update_refused", map_refused_},
           {"slices", a.slices().size()},
           {"payload_bytes", offer.payload_bytes},

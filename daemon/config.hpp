@@ -1,6 +1,7 @@
 #pragma once
 // tomomapd's configuration file (TOML). Its keys are declared in settings.hpp;
 // docs/configuration.md lists them.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,15 +31,13 @@ struct Config {
   std::string file;                      ///< where it was read from
   transport::TransportConfig transport;  ///< agent id, domain, address, ports, peers, bandwidth
   std::string map;  ///< own map file (absolute, or relative to the config file); empty with ros2.map_topic
-  /// `grid` and the [match] table; the defaults are MatchParams', but for
-  /// levelling: the fleet's transforms are 4-DoF between the maps' own
-  /// frames, and a levelled map's frame is not its own, so a map leaning
-  /// beyond max_tilt is not offered.
-  MatchParams match = [] {
-    MatchParams m;
-    m.level = false;
-    return m;
-  }();
+  /// The map's up direction in its own frame where the user knows it (the
+  /// SLAM's gravity estimate, an IMU's); none: estimated from the map.
+  std::optional<Eigen::Vector3d> map_up;
+  /// `grid` and the [match] table, MatchParams' defaults: a map leaning
+  /// beyond max_tilt is levelled before it is sliced, and the fleet's
+  /// transforms say each map's up (AgreedTransform).
+  MatchParams match;
   std::string output_dir;  ///< transforms.json, status.json
   LogLevel log_level = LogLevel::Info;
   double claim_timeout_s = 30;    ///< a claim without a result is void after this [s]

@@ -14,7 +14,8 @@ bool sameTree(const std::vector<TreeEdge>& a, const std::vector<TreeEdge>& b) {
   for (size_t i = 0; i < a.size(); ++i) {
     const Pose4 &p = a[i].T_parent_child, &q = b[i].T_parent_child;
     if (a[i].parent != b[i].parent || a[i].child != b[i].child || a[i].stamp_ms != b[i].stamp_ms || p.x != q.x ||
-        p.y != q.y || p.z != q.z || p.yaw != q.yaw)
+        p.y != q.y || p.z != q.z || p.yaw != q.yaw || a[i].parent_up != b[i].parent_up ||
+        a[i].child_up != b[i].child_up)
       return false;
   }
   return true;
@@ -63,7 +64,7 @@ void FleetOutputs::handTree(const Config& config) {
   if (published_ && sameTree(tree, *published_)) return;
   std::vector<transport::TfFrame> frames;
   for (const auto& e : tree)
-    frames.push_back({config.ros2.frameOf(e.parent), config.ros2.frameOf(e.child), e.T_parent_child, e.stamp_ms});
+    frames.push_back({config.ros2.frameOf(e.parent), config.ros2.frameOf(e.child), e.ownFrames(), e.stamp_ms});
   publish_(frames);
   log_.info("ROS 2: /tf_static holds " + std::to_string(frames.size()) + " of the fleet's " +
             std::to_string(config.transport.peers.size()) + " other frames under " +

@@ -8,7 +8,8 @@ MatchWorker::~MatchWorker() {
   if (thread_.joinable()) thread_.join();
 }
 
-AgreedTransform agreedFromMatch(const PairAt& pair, const MatchResult& r, const std::string& me) {
+AgreedTransform agreedFromMatch(const PairAt& pair, const MatchResult& r, const MapFeatures& target,
+                                const MapFeatures& source, const std::string& me) {
   AgreedTransform t;
   t.target = pair.pair.first;
   t.source = pair.pair.second;
@@ -18,6 +19,9 @@ AgreedTransform agreedFromMatch(const PairAt& pair, const MatchResult& r, const 
   t.reliable = r.reliable;
   t.reason = r.reason;
   t.T_target_source = r.T_target_source;
+  t.target_up = target.slicedUp();
+  t.source_up = source.slicedUp();
+  t.T_target_source_6dof = r.T_target_source_6dof;
   t.support = r.support;
   t.runner_up_support = r.runner_up_support;
   t.inliers = static_cast<uint32_t>(r.inliers);
@@ -34,11 +38,11 @@ void MatchWorker::start(const PairAt& pair, std::shared_ptr<const MapFeatures> t
     AgreedTransform& t = c.transform;
     try {
       const MatchResult r = matchFeatures(*target, *source, params, {}, &caches_[pair.pair]);
-      t = agreedFromMatch(pair, r, me);
+      t = agreedFromMatch(pair, r, *target, *source, me);
       c.slice_pairs = r.slice_pairs;
       c.slice_pairs_recalled = r.slice_pairs_recalled;
     } catch (const std::exception& ex) {
-      t = agreedFromMatch(pair, MatchResult{}, me);
+      t = agreedFromMatch(pair, MatchResult{}, *target, *source, me);
       t.reason = ex.what();
     }
     t.computed_at_ms = wallMs();

@@ -45,7 +45,8 @@ class MatchWorker {
   std::map<PairKey, PairCache> caches_;
 };
 
-/// The stored form of a match of `pair` computed by `me`.
-AgreedTransform agreedFromMatch(const PairAt& pair, const MatchResult& r, const std::string& me);
+/// The stored form of a match of `pair` computed by `me` on these maps (each levelled or not).
+AgreedTransform agreedFromMatch(const PairAt& pair, const MatchResult& r, const MapFeatures& target,
+                                const MapFeatures& source, const std::string& me);
 
 }  // namespace tomomap::daemon

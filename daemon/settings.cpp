@@ -57,6 +57,24 @@ Check rosTopic(const V& v) {
 
 const char* const kLevels[] = {"debug", "info", "warning", "error"};
 
+/// "X, Y, Z" as a direction (any length but zero); none where it is not one.
+std::optional<Eigen::Vector3d> direction(const std::string& text) {
+  std::istringstream in(text);
+  Eigen::Vector3d v;
+  char comma = 0;
+  if (!(in >> v.x() >> comma) || comma != ',' || !(in >> v.y() >> comma) || comma != ',' || !(in >> v.z()))
+    return std::nullopt;
+  in >> std::ws;
+  if (!in.eof() || !v.allFinite() || !(v.norm() > 0)) return std::nullopt;
+  return v;
+}
+
+std::string directionText(const Eigen::Vector3d& v) {
+  std::ostringstream o;
+  o << v.x() << ", " << v.y() << ", " << v.z();
+  return o.str();
+}
+
 /// Declares settings in the reference's order, one statement each.
 class Declare {
  public:
@@ -96,13 +114,28 @@ std::vector<Setting> declare() {
   }
   {
     Setting& s = d("map", K::Text, "path", Reload::AtOnce,
-                   "the robot's gravity-aligned map (PCD, PLY, XYZ/CSV text, OctoMap .bt/.ot; docs/cli.md \"Map "
+                   "the robot's map, gravity-aligned or leaning as its SLAM saved it (levelled: `map_up`) (PCD, PLY, "
+                   "XYZ/CSV text, OctoMap .bt/.ot; docs/cli.md \"Map "
                    "files\"); followed: a rewrite (in place or by rename) is read 1 s after the last write; a file "
                    "that does not exist yet is waited for (`--check` warns), one that exists but cannot be read is "
                    "an error (exit 2)");
     s.path = true;
     s.default_text = "required (unless `[ros2]` `map_topic`)";
     bindField(s, [](Config& c) { return &c.map; });
+  }
+  {
+    Setting& s = d("map_up", K::Text, "X, Y, Z", Reload::AtOnce,
+                   "the map's up direction in its own frame where it is known (its SLAM's gravity estimate, an "
+                   "IMU's), e.g. \"0.05, -0.02, 1\": the map is levelled by it instead of by the estimate read off "
+                   "its floors (docs/operations.md, \"Maps that lean\")");
+    s.default_text = "none: estimated";
+    s.shown = [](const Config& c) { return c.map_up ? directionText(*c.map_up) : "(none: estimated)"; };
+    s.check = [](const V& v) -> Check {
+      if (direction(text(v))) return std::nullopt;
+      return "must be a non-zero direction \"X, Y, Z\" (three numbers separated by commas)";
+    };
+    s.get = [](const Config& c) -> V { return c.map_up ? directionText(*c.map_up) : std::string(); };
+    s.set = [](Config& c, const V& v) { c.map_up = direction(text(v)); };
   }
   d.match(matchSetting("grid"), "grid");
   bindField(range(d("domain", K::Integer, "", Reload::Rejoin, "DDS domain id, the same on every agent"), 0, 232),

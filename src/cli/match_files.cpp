@@ -51,13 +51,7 @@ Described describeFile(const std::string& path, const std::string& role, const M
   if (sample) *sample = sourceSample(map);
   d.features = describeMap(map, params, &d.spent, nullptr, nullptr, upOf(up));
   const MapFeatures& f = d.features;
-  if (f.leveled)
-    d.err += "note: " + path + ": levelled: it leaned " + fixed(degrees(f.tilt.angle), 1) + " +- " +
-             fixed(degrees(f.tilt.uncertainty), 1) + " deg from gravity (" +
-             (f.tilt.cue == Tilt::Cue::given    ? "as given"
-              : f.tilt.cue == Tilt::Cue::floors ? "read off its floors"
-                                                : "read off its walls") +
-             ")\n";
+  if (f.leveled) d.err += "note: " + path + ": levelled: it leaned " + leanText(f.tilt) + "\n";
   d.inputs[role + "_stray_voxels"] = f.occupancy.stray;
   if (f.occupancy.stray > 0)
     d.err += "warning: " + path + ": left out " + std::to_string(f.occupancy.stray) +

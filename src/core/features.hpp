@@ -34,7 +34,9 @@ struct MapFeatures {
   /// when the sender ships them). Lets the matcher refine densely; may be empty.
   SliceStack occupancy;
   /// How the map was found to lean before slicing, and whether it was levelled
-  /// (turned by tilt.leveling()) first. Known where the map was described, not sent.
+  /// (turned by tilt.leveling()) first. Where the map was described, as
+  /// measured or given; a peer's map has the up it was levelled by (its
+  /// announcement's), given.
   Tilt tilt;
   bool leveled = false;
   /// Where the voxel filter's cubes start (voxelFilter's corner), and how many
@@ -43,6 +45,9 @@ struct MapFeatures {
   int kept_slices = 0;
 
   double sliceHeight(int k) const { return z_min + k * grid; }
+  /// The up direction, in the map's own frame, its slices are level to: z
+  /// where it was sliced as it is.
+  Eigen::Vector3d slicedUp() const { return leveled ? tilt.up : Eigen::Vector3d::UnitZ(); }
   size_t featureCount() const;
   Eigen::Vector2d centre() const;  ///< mean x, y of the keypoints [m]
 };

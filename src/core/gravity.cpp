@@ -7,6 +7,8 @@
 #include <optional>
 #include <unordered_map>
 
+#include "text.hpp"
+
 namespace tomomap {
 namespace {
 
@@ -274,6 +276,34 @@ Tilt givenTilt(const Eigen::Vector3d& up) {
   t.up = up.normalized();
   t.angle = std::acos(std::clamp(t.up.z(), -1.0, 1.0));
   return t;
+}
+
+bool levelableUp(const Eigen::Vector3d& up) {
+  return up.allFinite() && std::abs(up.norm() - 1.0) < 1e-6 && up.z() >= std::cos(kMaxLevelable) - 1e-9;
+}
+
+std::string leanText(const Tilt& t) {
+  return fixed(degrees(t.angle), 1) + " +- " + fixed(degrees(t.uncertainty), 1) + " deg from gravity (" +
+         (t.cue == Tilt::Cue::given    ? "as given"
+          : t.cue == Tilt::Cue::floors ? "read off its floors"
+                                       : "read off its walls") +
+         ")";
+}
+
+Eigen::Quaterniond Tilt::leveling() const { return levelingOf(up); }
+
+Eigen::Quaterniond levelingOf(const Eigen::Vector3d& up) {
+  return Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ());
+}
+
+Eigen::Matrix4d betweenOwnFrames(const Eigen::Matrix4d& T, const Eigen::Vector3d& target_up,
+                                 const Eigen::Vector3d& source_up) {
+  const auto rotation = [](const Eigen::Vector3d& up) {
+    Eigen::Matrix4d R = Eigen::Matrix4d::Identity();
+    R.topLeftCorner<3, 3>() = levelingOf(up).toRotationMatrix();
+    return R;
+  };
+  return rotation(target_up).transpose() * T * rotation(source_up);
 }
 
 Points rotatePoints(const Points& in, const Eigen::Quaterniond& rotation) {

@@ -3,6 +3,7 @@
 // maps; map files from LiDAR odometry (KISS-ICP, FAST-LIO) sit in the first
 // sensor or IMU frame and are tilted whenever that was.
 #include <Eigen/Geometry>
+#include <string>
 
 #include "types.hpp"
 
@@ -31,14 +32,28 @@ struct Tilt {
   /// uncertainty not beyond it (or not measured).
   bool mayBeWithin(double tolerance) const { return !measured || angle - uncertainty <= tolerance; }
 
-  /// The rotation that makes the map level: it turns `up` onto z (the
-  /// smallest such rotation: no yaw is added).
-  Eigen::Quaterniond leveling() const { return Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ()); }
+  /// The rotation that makes the map level (levelingOf its up).
+  Eigen::Quaterniond leveling() const;
 };
+
+/// The rotation that makes a map whose up is `up` level: it turns `up` onto z
+/// (the smallest such rotation: no yaw is added). p_levelled = R p_own.
+Eigen::Quaterniond levelingOf(const Eigen::Vector3d& up);
+
+/// A transform between two levelled maps (p_target_levelled = T
+/// p_source_levelled) as the transform between their own frames, from each
+/// map's up in its own frame (z for a map matched as it is):
+/// R_target^-1 T R_source.
+Eigen::Matrix4d betweenOwnFrames(const Eigen::Matrix4d& T, const Eigen::Vector3d& target_up,
+                                 const Eigen::Vector3d& source_up);
 
 /// Beyond this lean the estimate can take walls for floors (a y-up map read
 /// 16-48 degrees): such a map is refused, never levelled.
 const double kMaxLevelable = radians(30.0);
+
+/// Whether `up` is one a map may be levelled by: a unit vector within
+/// kMaxLevelable of z (what a peer may announce).
+bool levelableUp(const Eigen::Vector3d& up);
 
 /// Tilt from the flat surfaces of a map: floors and ceilings face up, walls
 /// face sideways. The map is cut into cubes a few grid cells wide; each flat
@@ -54,6 +69,9 @@ Tilt estimateTilt(const Points& map, double grid);
 /// points 0.5-0.8 of them on the real maps.
 constexpr double kFairShare = 0.25;
 bool fairPart(const Tilt& part, const Tilt& whole);
+
+/// "10.0 +- 0.2 deg from gravity (read off its floors)", as logged and printed.
+std::string leanText(const Tilt& t);
 
 /// The tilt of a map whose up direction is known (`up` in the map's frame,
 /// any length): exact, to be levelled by whatever it leans.

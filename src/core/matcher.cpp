@@ -34,16 +34,6 @@ Eigen::Vector3d inlierSpread(const Refined& r) {
   return (sq / static_cast<double>(r.inliers.size()) - mean.cwiseProduct(mean)).cwiseMax(0.0).cwiseSqrt();
 }
 
-/// p_target = R_target^-1 T R_source p_source, with R a map's levelling rotation.
-Eigen::Matrix4d unleveled(const Eigen::Matrix4d& T, const MapFeatures& target, const MapFeatures& source) {
-  const auto rotation = [](const MapFeatures& m) {
-    Eigen::Matrix4d R = Eigen::Matrix4d::Identity();
-    if (m.leveled) R.topLeftCorner<3, 3>() = m.tilt.leveling().toRotationMatrix();
-    return R;
-  };
-  return rotation(target).inverse() * T * rotation(source);
-}
-
 /// The middle of a map's occupancy [m]: its raster's centre, halfway up its slices.
 Eigen::Vector3d occupancyCentre(const SliceStack& s) {
   const Eigen::Vector2d c = s.grid.centre();
@@ -228,7 +218,7 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
     }
   }
   if (target.leveled || source.leveled || (r.finish && r.finish->held))
-    r.T_target_source_6dof = unleveled(answer, target, source);
+    r.T_target_source_6dof = betweenOwnFrames(answer, target.slicedUp(), source.slicedUp());
   return r;
 }
 

@@ -67,6 +67,14 @@ struct Pose4 {
   }
 };
 
+/// Whether a 4x4 matrix is a rigid transform: finite, a proper rotation (to
+/// 1e-6) and a translation, last row 0 0 0 1.
+inline bool isRigid(const Eigen::Matrix4d& m) {
+  if (!m.allFinite() || !m.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1))) return false;
+  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
+  return (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6 && r.determinant() > 0;
+}
+
 /// One keyframe of a SLAM sequence: its points in the sensor (body) frame and
 /// where the SLAM put it.
 struct PosedScan {

@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "core/gravity.hpp"
+
 namespace tomomap {
 
 std::string chainText(const std::vector<std::string>& agents, bool closed) {
@@ -23,10 +25,24 @@ uint64_t parseVersion(const std::string& text) {
   return std::stoull(text, nullptr, 16);
 }
 
+Eigen::Matrix4d AgreedTransform::ownFrames() const {
+  return T_target_source_6dof.value_or(betweenOwnFrames(T_target_source.matrix(), target_up, source_up));
+}
+
 nlohmann::json matrixJson(const Eigen::Matrix4d& M) {
   nlohmann::json m = nlohmann::json::array();
   for (int r = 0; r < 4; ++r) m.push_back({M(r, 0), M(r, 1), M(r, 2), M(r, 3)});
   return m;
+}
+
+Eigen::Matrix4d matrixFromJson(const nlohmann::json& rows) {
+  Eigen::Matrix4d M;
+  for (int r = 0; r < 4; ++r) {
+    const auto row = rows.at(static_cast<size_t>(r)).get<std::array<double, 4>>();
+    for (int c = 0; c < 4; ++c) M(r, c) = row[static_cast<size_t>(c)];
+  }
+  if (!isRigid(M)) throw InputError("a 4x4 matrix that is not a rotation and a translation");
+  return M;
 }
 
 nlohmann::json toJson(const Pose4& T) {
@@ -44,6 +60,9 @@ nlohmann::json toJson(const AgreedTransform& t) {
                    {"matching_seconds", t.seconds}};
   if (t.reliable) {
     j["T_target_source"] = toJson(t.T_target_source);
+    j["T_target_source_6dof"] = matrixJson(t.ownFrames());
+    j["target_up"] = {t.target_up.x(), t.target_up.y(), t.target_up.z()};
+    j["source_up"] = {t.source_up.x(), t.source_up.y(), t.source_up.z()};
   } else {
     j["reason"] = t.reason;
   }
@@ -69,6 +88,14 @@ AgreedTransform agreedFromJson(const nlohmann::json& j) {
       const auto& T = j.at("T_target_source");
       t.T_target_source = {T.at("x").get<double>(), T.at("y").get<double>(), T.at("z").get<double>(),
                            T.at("yaw").get<double>()};
+      // Files written before maps were levelled in the fleet have neither: level maps, 4-DoF.
+      for (auto [key, up] : {std::pair{"target_up", &t.target_up}, std::pair{"source_up", &t.source_up}})
+        if (j.contains(key)) {
+          const auto v = j.at(key).get<std::array<double, 3>>();
+          *up = {v[0], v[1], v[2]};
+          if (!levelableUp(*up)) throw InputError(std::string(key) + " is not a unit vector within 30 deg of z");
+        }
+      if (j.contains("T_target_source_6dof")) t.T_target_source_6dof = matrixFromJson(j.at("T_target_source_6dof"));
     } else {
       t.reason = j.value("reason", "");
     }

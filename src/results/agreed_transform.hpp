@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,8 +34,15 @@ struct AgreedTransform {
   uint64_t target_version = 0, source_version = 0;  ///< the maps' versions it was computed for
   bool reliable = false;                            ///< false: computed, no reliable match (T is then meaningless)
   std::string reason;                               ///< why not, when not reliable
-  Pose4 T_target_source;                            ///< p_target = T_target_source * p_source
-  int support = 0;                                  ///< agreeing slice pairs
+  /// p_target = T_target_source * p_source, between the maps as sliced:
+  /// levelled where a map leaned (its up below), else as they are.
+  Pose4 T_target_source;
+  /// Each map's up direction in its own frame, as it was levelled by (z: sliced as it is).
+  Eigen::Vector3d target_up = Eigen::Vector3d::UnitZ(), source_up = Eigen::Vector3d::UnitZ();
+  /// The whole transform between the maps' own frames where the matcher gave
+  /// one (the 6-DoF finish's); otherwise ownFrames() derives it from the above.
+  std::optional<Eigen::Matrix4d> T_target_source_6dof;
+  int support = 0;  ///< agreeing slice pairs
   int runner_up_support = 0;
   uint32_t inliers = 0;
   std::array<double, 3> spread{};  ///< std. dev. of the inliers in target x, y, z [m]
@@ -43,6 +51,8 @@ struct AgreedTransform {
   double seconds = 0;           ///< matching time [s]
 
   PairKey pair() const { return {target, source}; }
+  /// p_target = ownFrames() * p_source, in the maps' own frames (6-DoF).
+  Eigen::Matrix4d ownFrames() const;
   /// Computed for exactly these versions of the two maps.
   bool isFor(uint64_t target_v, uint64_t source_v) const {
     return target_version == target_v && source_version == source_v;
@@ -51,6 +61,8 @@ struct AgreedTransform {
 
 /// A 4x4 matrix as four rows.
 nlohmann::json matrixJson(const Eigen::Matrix4d& M);
+/// The inverse for a rigid transform; throws InputError (or a json exception) for anything else.
+Eigen::Matrix4d matrixFromJson(const nlohmann::json& rows);
 /// A 4-DoF transform as stored and printed: x, y, z [m], yaw [rad] and its 4x4 matrix.
 nlohmann::json toJson(const Pose4& T);
 nlohmann::json toJson(const AgreedTransform& t);

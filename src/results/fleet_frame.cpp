@@ -267,13 +267,28 @@ FleetFrame buildFleetFrame(const std::vector<AgreedTransform>& agreed, const std
   }
   frame.converged = optimise(g, reference, poses, limits, frame.optimised_pairs);
 
-  frame.poses.push_back({reference, poses.at(reference), paths.at(reference)});
+  // Each map's up, as its best-supported link says (every link of a map's
+  // version says the same: it was announced with the map).
+  std::map<std::string, std::pair<int, Eigen::Vector3d>> ups;
+  const auto note = [&](const std::string& agent, int support, const Eigen::Vector3d& up) {
+    const auto it = ups.find(agent);
+    if (it == ups.end() || support > it->second.first) ups[agent] = {support, up};
+  };
+  for (const auto& t : kept) {
+    note(t.target, t.support, t.target_up);
+    note(t.source, t.support, t.source_up);
+  }
+  const auto upOf = [&](const std::string& agent) {
+    const auto it = ups.find(agent);
+    return it == ups.end() ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : it->second.second;
+  };
+  frame.poses.push_back({reference, poses.at(reference), upOf(reference), paths.at(reference)});
   std::set<std::string> everyone(agents.begin(), agents.end());
   for (const auto& [key, t] : reliable) everyone.insert({key.first, key.second});
   for (const auto& agent : everyone) {
     if (agent == reference) continue;
     if (poses.count(agent))
-      frame.poses.push_back({agent, poses.at(agent), paths.at(agent)});
+      frame.poses.push_back({agent, poses.at(agent), upOf(agent), paths.at(agent)});
     else
       frame.unreachable.push_back(agent);
   }
@@ -286,14 +301,19 @@ std::vector<TreeEdge> treeOf(const FleetFrame& frame, const std::string& root, u
   const Pose4 T_root_reference = r->T_reference_agent.inverse();
   std::vector<TreeEdge> tree;
   for (const auto& p : frame.poses)
-    if (p.agent != root) tree.push_back({root, p.agent, T_root_reference * p.T_reference_agent, stamp_ms});
+    if (p.agent != root) tree.push_back({root, p.agent, T_root_reference * p.T_reference_agent, r->up, p.up, stamp_ms});
   return tree;
 }
 
 nlohmann::json toJson(const FleetFrame& frame) {
   nlohmann::json poses = nlohmann::json::array(), pairs = nlohmann::json::array();
   for (const auto& p : frame.poses)
-    poses.push_back({{"agent", p.agent}, {"T_reference_agent", toJson(p.T_reference_agent)}, {"path", p.path}});
+    poses.push_back({{"agent", p.agent},
+                     {"T_reference_agent", toJson(p.T_reference_agent)},
+                     {"up", {p.up.x(), p.up.y(), p.up.z()}},
+                     {"T_reference_agent_6dof",
+                      matrixJson(betweenOwnFrames(p.T_reference_agent.matrix(), frame.poses.front().up, p.up))},
+                     {"path", p.path}});
   for (const auto& v : frame.pairs) {
     nlohmann::json j{{"pair", pairText(v.pair)}, {"verdict", consistencyName(v.verdict)}, {"cycle", v.cycle}};
     if (v.verdict != Consistency::Unchecked)

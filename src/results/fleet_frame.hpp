@@ -38,7 +38,9 @@ struct PairVerdict {
 
 struct AgentPose {
   std::string agent;
-  Pose4 T_reference_agent;  ///< p_reference = T_reference_agent * p_agent
+  Pose4 T_reference_agent;  ///< p_reference = T_reference_agent * p_agent, between the maps as sliced (levelled)
+  /// Its map's up in its own frame (z where it was sliced as it is).
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   /// How it is reached: the reference, the agents in between, the agent
   /// (the best-supported links; the pose itself comes from every pair).
   std::vector<std::string> path;

@@ -30,10 +30,14 @@ std::vector<TreeEdge> spanningTree(const std::vector<AgreedTransform>& agreed, c
       e.parent = best->target;
       e.child = best->source;
       e.T_parent_child = best->T_target_source;
+      e.parent_up = best->target_up;
+      e.child_up = best->source_up;
     } else {
       e.parent = best->source;
       e.child = best->target;
       e.T_parent_child = best->T_target_source.inverse();
+      e.parent_up = best->source_up;
+      e.child_up = best->target_up;
     }
     in.insert(e.child);
     tree.push_back(std::move(e));

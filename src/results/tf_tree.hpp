@@ -6,13 +6,19 @@
 #include <vector>
 
 #include "agreed_transform.hpp"
+#include "core/gravity.hpp"
 
 namespace tomomap {
 
 struct TreeEdge {
   std::string parent, child;  ///< agent ids
-  Pose4 T_parent_child;       ///< p_parent = T_parent_child * p_child
-  uint64_t stamp_ms = 0;      ///< when the transform behind it was computed [ms since the epoch]
+  Pose4 T_parent_child;       ///< p_parent = T_parent_child * p_child, between the maps as sliced (levelled)
+  /// Each map's up in its own frame (AgreedTransform's target_up, source_up).
+  Eigen::Vector3d parent_up = Eigen::Vector3d::UnitZ(), child_up = Eigen::Vector3d::UnitZ();
+  uint64_t stamp_ms = 0;  ///< when the transform behind it was computed [ms since the epoch]
+
+  /// p_parent = ownFrames() * p_child, between the maps' own frames (what tf carries).
+  Eigen::Matrix4d ownFrames() const { return betweenOwnFrames(T_parent_child.matrix(), parent_up, child_up); }
 };
 
 /// The reliable transforms among `agreed` that tie the most maps to `root`,

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/gravity.hpp"
+
 namespace tomomap::transport {
 
 namespace {
@@ -22,9 +24,11 @@ wire::TransformEstimate toWire(const AgreedTransform& t) {
   e.y(T.y);
   e.z(T.z);
   e.yaw(T.yaw);
-  const Eigen::Matrix4d M = T.matrix();
+  const Eigen::Matrix4d M = t.ownFrames();
   for (int row = 0; row < 4; ++row)
     for (int col = 0; col < 4; ++col) e.matrix()[static_cast<size_t>(4 * row + col)] = M(row, col);
+  e.target_up({t.target_up.x(), t.target_up.y(), t.target_up.z()});
+  e.source_up({t.source_up.x(), t.source_up.y(), t.source_up.z()});
   e.support(t.support);
   e.runner_up_support(t.runner_up_support);
   e.inliers(t.inliers);
@@ -39,6 +43,14 @@ Rejection fromWire(const wire::TransformEstimate& e, AgreedTransform& t) {
   if (e.target().to_string() >= e.source().to_string()) return {Reject::UnorderedPair};
   for (double v : {e.x(), e.y(), e.z(), e.yaw()})
     if (!std::isfinite(v)) return {Reject::NonFiniteTransform};
+  Eigen::Matrix4d M;
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 4; ++col) M(row, col) = e.matrix()[static_cast<size_t>(4 * row + col)];
+  if (!M.allFinite()) return {Reject::NonFiniteTransform};
+  if (!isRigid(M)) return {Reject::NotRigid};
+  const Eigen::Vector3d target_up(e.target_up()[0], e.target_up()[1], e.target_up()[2]);
+  const Eigen::Vector3d source_up(e.source_up()[0], e.source_up()[1], e.source_up()[2]);
+  if (!levelableUp(target_up) || !levelableUp(source_up)) return {Reject::BadUp};
   t = AgreedTransform{};
   t.target = e.target().to_string();
   t.source = e.source().to_string();
@@ -47,6 +59,9 @@ Rejection fromWire(const wire::TransformEstimate& e, AgreedTransform& t) {
   t.reliable = e.reliable();
   t.reason = e.reason().to_string();
   t.T_target_source = {e.x(), e.y(), e.z(), e.yaw()};
+  t.target_up = target_up;
+  t.source_up = source_up;
+  t.T_target_source_6dof = M;
   t.support = e.support();
   t.runner_up_support = e.runner_up_support();
   t.inliers = e.inliers();

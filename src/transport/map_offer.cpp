@@ -90,6 +90,8 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const Feature
   a.x_min(g.x_min);
   a.y_min(g.y_min);
   a.z_min(f.z_min);
+  const Eigen::Vector3d up = f.slicedUp();
+  a.up({up.x(), up.y(), up.z()});
   a.width(static_cast<uint16_t>(g.width));
   a.height(static_cast<uint16_t>(g.height));
   a.slice_count(f.slice_count);
@@ -219,6 +221,7 @@ uint64_t mapVersion(const wire::MapAnnouncement& a) {
   mix(bits(a.x_min()));
   mix(bits(a.y_min()));
   mix(bits(a.z_min()));
+  for (double u : a.up()) mix(bits(u));
   mix((uint64_t{a.width()} << 16) | a.height());
   const auto& fs = a.features();
   mix((uint64_t{fs.max_features()} << 32) | (uint64_t{fs.fast_threshold()} << 16) | fs.pad());
@@ -228,6 +231,8 @@ uint64_t mapVersion(const wire::MapAnnouncement& a) {
   }
   return h;
 }
+
+Eigen::Vector3d upOf(const wire::MapAnnouncement& a) { return {a.up()[0], a.up()[1], a.up()[2]}; }
 
 FeatureParams featureParamsOf(const wire::MapAnnouncement& a) {
   FeatureParams p;
@@ -241,6 +246,7 @@ Rejection validate(const wire::MapAnnouncement& a) {
   if (!(a.grid() > 0) || !std::isfinite(a.grid()) || !std::isfinite(a.x_min()) || !std::isfinite(a.y_min()) ||
       !std::isfinite(a.z_min()))
     return {Reject::BadGridOrOrigin};
+  if (!levelableUp(upOf(a))) return {Reject::BadUp};
   if (a.width() == 0 || a.height() == 0 || a.width() > kMaxImageSide || a.height() > kMaxImageSide)
     return {Reject::BadRaster};
   if (a.slice_count() <= 0 || a.slice_count() > 100000) return {Reject::BadSliceCount};

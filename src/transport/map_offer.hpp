@@ -63,6 +63,8 @@ uint64_t mapVersion(const wire::MapAnnouncement& a);
 
 /// The feature settings an announcement carries, as the core takes them.
 FeatureParams featureParamsOf(const wire::MapAnnouncement& a);
+/// The up direction the announced map's slices are level to, in its own frame.
+Eigen::Vector3d upOf(const wire::MapAnnouncement& a);
 
 /// Checks an announcement before anything is allocated for it.
 Rejection validate(const wire::MapAnnouncement& a);

@@ -116,6 +116,11 @@ MapFeatures Reassembler::build() const {
   }
   stack.partial = !sent_as_features.empty();
   MapFeatures out = extractFeatures(std::move(stack), featureParamsOf(a));
+  // Levelled by its sender: the transforms between the maps' own frames undo it.
+  if (const Eigen::Vector3d up = upOf(a); up != Eigen::Vector3d::UnitZ()) {
+    out.tilt = givenTilt(up);
+    out.leveled = true;
+  }
   for (auto& s : sent_as_features) out.slices.push_back(std::move(s));
   std::sort(out.slices.begin(), out.slices.end(),
             [](const SliceFeatures& x, const SliceFeatures& y) { return x.index < y.index; });

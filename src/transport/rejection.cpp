@@ -22,6 +22,8 @@ std::string Rejection::text() const {
       return "announcement with feature settings out of range";
     case Reject::VersionMismatch:
       return "announcement whose version does not match its content";
+    case Reject::BadUp:
+      return "an up direction that is not a unit vector within 30 deg of z";
     case Reject::NotAnnounced:
       return "slice " + std::to_string(slice) + " was not announced";
     case Reject::PartNumbering:
@@ -42,6 +44,8 @@ std::string Rejection::text() const {
       return "estimate with an unordered pair";
     case Reject::NonFiniteTransform:
       return "estimate with a non-finite transform";
+    case Reject::NotRigid:
+      return "estimate whose whole transform is not rigid";
   }
   return "unknown rejection";
 }

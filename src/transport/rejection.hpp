@@ -16,6 +16,7 @@ enum class Reject {
   OversizedSlice,  ///< announcement: a slice larger than any real slice can be
   BadFeatureSettings,
   VersionMismatch,  ///< announcement whose version is not the hash of its content
+  BadUp,            ///< announcement or estimate: an up that is not a unit vector within 30 deg of z
   NotAnnounced,     ///< sample of a slice the announcement does not list
   PartNumbering,
   MixedEncoding,
@@ -26,6 +27,7 @@ enum class Reject {
   OverBudget,     ///< a peer's map that would take more memory than peer_memory_mb
   UnorderedPair,  ///< estimate whose target id is not below its source id
   NonFiniteTransform,
+  NotRigid,  ///< estimate whose whole transform is not a rotation and a translation
 };
 
 struct Rejection {

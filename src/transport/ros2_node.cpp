@@ -31,8 +31,6 @@ namespace ros_sensor = sensor_msgs::msg::dds_;
 constexpr const char* kTfStaticTopic = "rt/tf_static";
 constexpr const char* kDiagnosticsTopic = "rt/diagnostics";
 
-Eigen::Vector4d yawQuaternion(double yaw) { return {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)}; }
-
 /// builtin_interfaces/Time for `ms` [ms since the epoch].
 builtin_interfaces::msg::dds_::Time_ rosTime(uint64_t ms) {
   builtin_interfaces::msg::dds_::Time_ t;
@@ -199,14 +197,14 @@ void Ros2Node::publishTfStatic(const std::vector<TfFrame>& frames) {
     t.header().stamp(rosTime(f.stamp_ms));
     t.header().frame_id(f.parent);
     t.child_frame_id(f.child);
-    t.transform().translation().x(f.T_parent_child.x);
-    t.transform().translation().y(f.T_parent_child.y);
-    t.transform().translation().z(f.T_parent_child.z);
-    const Eigen::Vector4d r = yawQuaternion(f.T_parent_child.yaw);
-    t.transform().rotation().x(r[0]);
-    t.transform().rotation().y(r[1]);
-    t.transform().rotation().z(r[2]);
-    t.transform().rotation().w(r[3]);
+    t.transform().translation().x(f.T_parent_child(0, 3));
+    t.transform().translation().y(f.T_parent_child(1, 3));
+    t.transform().translation().z(f.T_parent_child(2, 3));
+    const Eigen::Quaterniond r(Eigen::Matrix3d(f.T_parent_child.topLeftCorner<3, 3>()));
+    t.transform().rotation().x(r.x());
+    t.transform().rotation().y(r.y());
+    t.transform().rotation().z(r.z());
+    t.transform().rotation().w(r.w());
     msg.transforms().push_back(std::move(t));
   }
   impl_->tf_static->write(&msg);

@@ -18,13 +18,10 @@
 namespace tomomap::transport {
 
 struct TfFrame {
-  std::string parent, child;  ///< frame ids
-  Pose4 T_parent_child;       ///< the child frame's pose in the parent frame
-  uint64_t stamp_ms = 0;      ///< [ms since the epoch]
+  std::string parent, child;       ///< frame ids
+  Eigen::Matrix4d T_parent_child;  ///< the child frame's pose in the parent frame (rigid)
+  uint64_t stamp_ms = 0;           ///< [ms since the epoch]
 };
-
-/// The ROS 2 message's quaternion (x, y, z, w) for a rotation by `yaw` about z.
-Eigen::Vector4d yawQuaternion(double yaw);
 
 /// One diagnostic_msgs/DiagnosticStatus.
 struct Diagnostic {

@@ -17,6 +17,7 @@
 #include "core/gravity.hpp"
 #include "fleet.hpp"
 #include "io/map_io.hpp"
+#include "results/agreed_transform.hpp"
 
 using namespace tomomap;
 using namespace tomomap::test;
@@ -310,7 +311,7 @@ TEST(Operations, ARewrittenMapIsAgreedAgainWithASmallerResend) {
   stopAll(fleet, {"alpha", "bravo"});
 }
 
-TEST(Operations, NeitherATiltedMapNorOneThatMatchesNothingReplacesTheAgreedTransform) {
+TEST(Operations, ALeaningMapIsLevelledAndAgreedAgainButNeitherJunkNorAMapLeaningTooFarReplacesTheAgreedTransform) {
   REQUIRE_DEMO_ROOM();
   TempDir dir;
   const Points original = loadMap(demoRoom() + "/demo-pcd2.pcd");
@@ -323,25 +324,54 @@ TEST(Operations, NeitherATiltedMapNorOneThatMatchesNothingReplacesTheAgreedTrans
   const auto status = fleet.readJson("bravo", "status.json");
   const std::string v1 = status["map"]["version"];
   EXPECT_LT(status["map"]["tilt_deg"].get<double>(), 1.0);
-  const auto agreed = fleet.transforms("alpha").at("alpha<-bravo");
+  EXPECT_FALSE(status["map"]["levelled"].get<bool>());
+  const Eigen::Matrix4d level_answer =
+      matrixFromJson(fleet.transforms("alpha").at("alpha<-bravo")["T_target_source_6dof"]);
 
-  // The SLAM system restarts with its first IMU frame leaning 5 degrees.
-  const Points rolled =
-      rotatePoints(original, Eigen::Quaterniond(Eigen::AngleAxisd(radians(5), Eigen::Vector3d::UnitX())));
+  // The SLAM system restarts with its first IMU frame leaning 5 degrees: the
+  // daemon levels the map, offers it, and the pair is agreed again; the whole
+  // transform between the maps' own frames takes the lean in, and says bravo's up.
+  const Eigen::AngleAxisd lean(radians(5), Eigen::Vector3d::UnitX());
+  const Points rolled = rotatePoints(original, Eigen::Quaterniond(lean));
   replaceMap(bravo_map, rolled);
+  std::string v2;
   ASSERT_TRUE(Fleet::waitFor(
-      [&] { return !fleet.readJson("bravo", "status.json")["map"].value("update_refused", "").empty(); }, 60s))
-      << fleet.log("bravo");
-  EXPECT_NE(fleet.log("bravo").find("own map is tilted "), std::string::npos) << fleet.log("bravo");
-  EXPECT_EQ(fleet.readJson("bravo", "status.json")["map"]["version"], v1) << "the level map stays on offer";
-  const auto view = runTomomap("status " + (dir / "out-bravo"));
-  EXPECT_NE(view.output.find("NOT offered: "), std::string::npos) << view.output;
-  for (const char* id : {"alpha", "bravo"}) {
-    const auto t = fleet.transforms(id);
-    ASSERT_TRUE(t.count("alpha<-bravo"));
-    EXPECT_EQ(t.at("alpha<-bravo")["T_target_source"], agreed["T_target_source"]) << id;
-    EXPECT_TRUE(t.at("alpha<-bravo")["reliable"].get<bool>()) << id;
+      [&] {
+        v2 = fleet.readJson("bravo", "status.json")["map"].value("version", v1);
+        if (v2 == v1) return false;
+        for (const char* id : {"alpha", "bravo"}) {
+          const auto t = fleet.transforms(id);
+          if (!t.count("alpha<-bravo") || t.at("alpha<-bravo")["source_version"] != v2) return false;
+        }
+        return true;
+      },
+      90s))
+      << fleet.log("alpha") << fleet.log("bravo");
+  EXPECT_NE(fleet.log("bravo").find("levelled: it leaned "), std::string::npos) << fleet.log("bravo");
+  const auto leaning = fleet.readJson("bravo", "status.json")["map"];
+  EXPECT_TRUE(leaning["levelled"].get<bool>());
+  EXPECT_NEAR(leaning["tilt_deg"].get<double>(), 5.0, 0.5);
+  const auto agreed = fleet.transforms("alpha").at("alpha<-bravo");
+  ASSERT_TRUE(agreed["reliable"].get<bool>()) << agreed.dump(2);
+  EXPECT_EQ(agreed, fleet.transforms("bravo").at("alpha<-bravo")) << "both hold the same agreement";
+  const Eigen::Vector3d bravo_up(agreed["source_up"][0], agreed["source_up"][1], agreed["source_up"][2]);
+  EXPECT_LT(degrees(std::acos(bravo_up.dot(lean * Eigen::Vector3d::UnitZ()))), 0.5) << agreed.dump(2);
+  // The level map's answer, with the lean undone: p_alpha = T_level * lean^-1 * p_rolled.
+  Eigen::Matrix4d unroll = Eigen::Matrix4d::Identity();
+  unroll.topLeftCorner<3, 3>() = lean.inverse().toRotationMatrix();
+  const Eigen::Matrix4d expected = level_answer * unroll;
+  const Eigen::Matrix4d whole = matrixFromJson(agreed["T_target_source_6dof"]);
+  const Eigen::Matrix3d turn = expected.topLeftCorner<3, 3>().transpose() * whole.topLeftCorner<3, 3>();
+  EXPECT_LT(degrees(Eigen::AngleAxisd(turn).angle()), 0.5) << whole << "\nexpected\n" << expected;
+  // Over the map, not at one point: its points land within 2 cells of where the level answer puts them.
+  double farthest = 0;
+  for (size_t i = 0; i < rolled.size(); i += 97) {
+    const Eigen::Vector4d q(rolled[i].x(), rolled[i].y(), rolled[i].z(), 1.0);
+    farthest = std::max(farthest, (whole * q - expected * q).norm());
   }
+  EXPECT_LT(farthest, 0.10);
+  std::printf("levelled 5 deg roll: the whole transform %.3f deg and at most %.3f m from the level answer's\n",
+              degrees(Eigen::AngleAxisd(turn).angle()), farthest);
 
   // Then a level map that matches nothing (a SLAM session gone wrong: scattered
   // returns): offered, matched, no reliable match, and the agreed transform stays.
@@ -357,20 +387,33 @@ TEST(Operations, NeitherATiltedMapNorOneThatMatchesNothingReplacesTheAgreedTrans
   };
   ASSERT_TRUE(Fleet::waitFor([&] { return kept("alpha") && kept("bravo"); }, 60s))
       << fleet.log("alpha") << fleet.log("bravo");
-  EXPECT_NE(fleet.readJson("bravo", "status.json")["map"]["version"], v1) << "the junk map is offered";
+  EXPECT_NE(fleet.readJson("bravo", "status.json")["map"]["version"], v2) << "the junk map is offered";
   for (const char* id : {"alpha", "bravo"}) {
-    EXPECT_EQ(fleet.transforms(id).at("alpha<-bravo")["T_target_source"], agreed["T_target_source"]) << id;
+    EXPECT_EQ(fleet.transforms(id).at("alpha<-bravo")["T_target_source_6dof"], agreed["T_target_source_6dof"]) << id;
     EXPECT_NE(fleet.log(id).find("the reliable transform agreed for their earlier versions stays"), std::string::npos)
         << fleet.log(id);
   }
   const auto kept_view = runTomomap("status " + (dir / "out-alpha"));
   EXPECT_NE(kept_view.output.find("KEPT: for earlier maps"), std::string::npos) << kept_view.output;
-  EXPECT_EQ(matchesComputedReaching(fleet, {"alpha", "bravo"}, 2), 2)
-      << "the first agreement and the junk map's, once each";
-  stopAll(fleet, {"alpha", "bravo"});
-  replaceMap(bravo_map, rolled);
+  EXPECT_EQ(matchesComputedReaching(fleet, {"alpha", "bravo"}, 3), 3)
+      << "the first agreement, the levelled map's and the junk map's, once each";
 
-  // Started on the leaning map, the daemon refuses it and says why: exit 2, which systemd does not restart.
+  // A map leaning 40 degrees (beyond what an estimate read off floors and
+  // walls can be trusted at): never levelled, refused as an update, the last map staying on offer.
+  const Points too_far =
+      rotatePoints(original, Eigen::Quaterniond(Eigen::AngleAxisd(radians(40), Eigen::Vector3d::UnitX())));
+  const std::string v3 = fleet.readJson("bravo", "status.json")["map"]["version"];
+  replaceMap(bravo_map, too_far);
+  ASSERT_TRUE(Fleet::waitFor(
+      [&] { return !fleet.readJson("bravo", "status.json")["map"].value("update_refused", "").empty(); }, 60s))
+      << fleet.log("bravo");
+  EXPECT_NE(fleet.log("bravo").find("own map is tilted "), std::string::npos) << fleet.log("bravo");
+  EXPECT_EQ(fleet.readJson("bravo", "status.json")["map"]["version"], v3) << "the last map stays on offer";
+  const auto view = runTomomap("status " + (dir / "out-bravo"));
+  EXPECT_NE(view.output.find("NOT offered: "), std::string::npos) << view.output;
+  stopAll(fleet, {"alpha", "bravo"});
+
+  // Started on it, the daemon refuses it and says why: exit 2, which systemd does not restart.
   fleet.start(agents[1], agents);
   EXPECT_EQ(fleet.waitExit("bravo", 60s), 2);
   EXPECT_EQ(countOf(fleet.log("bravo"), "own map is tilted"), 2u) << "once refused as an update, once at start\n"

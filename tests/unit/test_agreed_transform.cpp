@@ -50,6 +50,45 @@ TEST(AgreedTransform, JsonRoundTrip) {
   broken = j;
   broken["target_version"] = "xyz";
   EXPECT_THROW(agreedFromJson(broken), InputError);
+
+  // A file written before maps were levelled in the fleet: level maps, 4-DoF.
+  nlohmann::json before = j;
+  for (const char* key : {"target_up", "source_up", "T_target_source_6dof"}) before.erase(key);
+  const AgreedTransform old = agreedFromJson(before);
+  EXPECT_TRUE(old.ownFrames().isApprox(t.T_target_source.matrix(), 1e-12));
+  EXPECT_EQ(old.source_up, Eigen::Vector3d::UnitZ());
+}
+
+TEST(AgreedTransform, ALevelledMapsUpTravelsAndTheWholeTransformUndoesIt) {
+  AgreedTransform t = sample();
+  // Bravo's map leaned 6 degrees about x and was levelled: its up in its own frame.
+  const Eigen::AngleAxisd lean(radians(6), Eigen::Vector3d::UnitX());
+  t.source_up = lean.inverse() * Eigen::Vector3d::UnitZ();
+  const Eigen::Matrix4d whole = t.ownFrames();
+  EXPECT_TRUE((whole.topLeftCorner<3, 3>() * t.source_up).isApprox(Eigen::Vector3d::UnitZ(), 1e-12))
+      << "bravo's up is alpha's z";
+  EXPECT_NEAR(whole(0, 3), 1.25, 1e-12) << "bravo's origin is where the levelled transform puts it";
+
+  AgreedTransform back;
+  ASSERT_FALSE(transport::fromWire(transport::toWire(t), back));
+  EXPECT_TRUE(back.ownFrames().isApprox(whole, 1e-12));
+  EXPECT_TRUE(back.source_up.isApprox(t.source_up, 1e-15));
+  const AgreedTransform stored = agreedFromJson(toJson(t));
+  EXPECT_TRUE(stored.ownFrames().isApprox(whole, 1e-12));
+  expectSame(stored, t);
+
+  // A forged estimate: an up beyond what any map is levelled by, a matrix that is not rigid.
+  wire::TransformEstimate e = transport::toWire(t);
+  e.source_up({0.0, 1.0, 0.0});
+  EXPECT_EQ(transport::fromWire(e, back), transport::Reject::BadUp);
+  e = transport::toWire(t);
+  e.matrix()[0] = 2.0;
+  EXPECT_EQ(transport::fromWire(e, back), transport::Reject::NotRigid);
+  e.matrix()[5] = std::nan("");
+  EXPECT_EQ(transport::fromWire(e, back), transport::Reject::NonFiniteTransform);
+  nlohmann::json forged = toJson(t);
+  forged["source_up"] = {0.0, 0.0, 2.0};
+  EXPECT_THROW(agreedFromJson(forged), InputError);
 }
 
 TEST(AgreedTransform, WireRoundTripAndChecks) {

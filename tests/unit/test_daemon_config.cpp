@@ -93,6 +93,24 @@ TEST(DaemonConfig, TheMatchTableOverridesTheMatchersDefaults) {
   EXPECT_NE(e.find("must be a table"), std::string::npos) << e;
 }
 
+TEST(DaemonConfig, AMapsKnownUpIsThreeNumbersAndLeavesTheEstimateAlone) {
+  TempDir dir;
+  const std::string base = "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n";
+  std::ofstream(dir / "c.toml") << base << "map_up = \"0.05, -0.02, 1\"\n";
+  const Config c = loadConfig(dir / "c.toml");
+  ASSERT_TRUE(c.map_up);
+  EXPECT_TRUE(c.map_up->isApprox(Eigen::Vector3d(0.05, -0.02, 1.0)));
+  EXPECT_NE(describe(c).find("map_up = 0.05, -0.02, 1"), std::string::npos) << describe(c);
+  std::ofstream(dir / "c.toml") << base;
+  EXPECT_FALSE(loadConfig(dir / "c.toml").map_up) << "estimated unless given";
+  EXPECT_TRUE(MatchParams{}.level && loadConfig(dir / "c.toml").match.level) << "a leaning map is levelled";
+  for (const char* bad : {"\"0, 0, 0\"", "\"1, 2\"", "\"up\"", "\"1, 2, 3, 4\"", "\"nan, 0, 1\""}) {
+    const std::string e = errorOf(dir, base + "map_up = " + bad + "\n");
+    EXPECT_NE(e.find("c.toml:4:"), std::string::npos) << bad << ": " << e;
+    EXPECT_NE(e.find("'map_up': must be a non-zero direction"), std::string::npos) << bad << ": " << e;
+  }
+}
+
 TEST(DaemonConfig, TheRos2TableTurnsTfStaticOnWithFramesAndARootFromTheFleet) {
   TempDir dir;
   const std::string base = "agent = \"bravo\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n";

@@ -58,17 +58,35 @@ TEST(FleetOutputs, TheFilesHoldTheFrameAndTheTreeIsHandedOnOnlyWhenItChanges) {
   ASSERT_EQ(handed[0].size(), 1u);
   EXPECT_EQ(handed[0][0].parent, "alpha/map");
   EXPECT_EQ(handed[0][0].child, "bravo/map");
-  EXPECT_NEAR(handed[0][0].T_parent_child.x, 1.0, 1e-9) << "bravo's pose in alpha's frame";
+  EXPECT_NEAR(handed[0][0].T_parent_child(0, 3), 1.0, 1e-9) << "bravo's pose in alpha's frame";
 
   outputs.update({alphaBravo(1)}, config);
   EXPECT_EQ(handed.size(), 1u) << "the same tree is not handed on again";
   outputs.update({alphaBravo(1.5)}, config);
   ASSERT_EQ(handed.size(), 2u);
-  EXPECT_NEAR(handed[1][0].T_parent_child.x, 1.5, 1e-9);
+  EXPECT_NEAR(handed[1][0].T_parent_child(0, 3), 1.5, 1e-9);
   // A new publisher (a ROS 2 node started again) gets the whole tree at once.
   outputs.setTreePublisher([&](const auto& frames) { handed.push_back(frames); });
   outputs.update({alphaBravo(1.5)}, config);
   EXPECT_EQ(handed.size(), 3u);
+
+  // Bravo's map leaned 8 degrees and was levelled before slicing: tf carries
+  // the transform between the maps' own frames, the lean included.
+  AgreedTransform leaning = alphaBravo(1.5);
+  const Eigen::AngleAxisd lean(radians(8), Eigen::Vector3d(1, 1, 0).normalized());
+  leaning.source_up = lean.inverse() * Eigen::Vector3d::UnitZ();  // its up, in its own (leaning) frame
+  outputs.update({leaning}, config);
+  ASSERT_EQ(handed.size(), 4u) << "a new up is a new tree";
+  const Eigen::Matrix4d T = handed[3][0].T_parent_child;
+  const Eigen::Vector3d bravo_up = leaning.source_up;
+  EXPECT_TRUE((T.topLeftCorner<3, 3>() * bravo_up).isApprox(Eigen::Vector3d::UnitZ(), 1e-9))
+      << "bravo's up lands on alpha's\n"
+      << T;
+  EXPECT_TRUE(T.isApprox(leaning.ownFrames(), 1e-12)) << T;
+  const auto agent = readJson(out + "/frame.json")["agents"][1];
+  EXPECT_EQ(agent["agent"], "bravo");
+  EXPECT_NEAR(agent["up"][0].get<double>(), bravo_up.x(), 1e-12);
+  EXPECT_NEAR(agent["T_reference_agent_6dof"][0][3].get<double>(), 1.5, 1e-9);
 }
 
 TEST(FleetOutputs, AFailedWriteIsSaidAndRetriedUntilItWorks) {

@@ -142,6 +142,28 @@ TEST(SliceCodec, InconsistentSamplesAreRejectedNotCrashed) {
   EXPECT_EQ(validate(a), Reject::BadFeatureSettings);
 }
 
+TEST(SliceCodec, ALevelledMapSaysItsUpAndTheReceiverUndoesItsLevelling) {
+  // The map as a SLAM saved it, its first frame leaning 8 degrees: levelled before slicing.
+  const Eigen::Quaterniond lean(Eigen::AngleAxisd(radians(8), Eigen::Vector3d(1, 2, 0).normalized()));
+  const MapFeatures f = describeAtDecimetre(rotatePoints(samplePoints(), lean));
+  ASSERT_TRUE(f.leveled) << degrees(f.tilt.angle);
+  const MapOffer offer = makeOffer("alpha", f, {}, 1000000, 4000);
+  EXPECT_FALSE(validate(offer.announcement)) << validate(offer.announcement).text();
+  const MapFeatures back = receiveAll(offer, /*shuffle=*/false).build();
+  EXPECT_TRUE(back.leveled);
+  EXPECT_TRUE(back.slicedUp().isApprox(f.slicedUp(), 1e-12));
+  EXPECT_LT(degrees(std::acos(back.slicedUp().dot(lean * Eigen::Vector3d::UnitZ()))), 0.5)
+      << "the up it was levelled by is the lean's";
+  EXPECT_EQ(sampleMap().slicedUp(), Eigen::Vector3d::UnitZ()) << "a level map is sliced as it is";
+
+  // An up no map is levelled by (the map on its side) is refused; another up is another version.
+  wire::MapAnnouncement a = offer.announcement;
+  a.up({0.0, 1.0, 0.0});
+  EXPECT_EQ(validate(a), Reject::BadUp);
+  a.up({0.0, 0.0, 1.0});
+  EXPECT_EQ(validate(a), Reject::VersionMismatch);
+}
+
 TEST(SliceCodec, AMapUpdateReusesTheSlicesThatDidNotChange) {
   // The robot's map gains a cabinet, inside its bounds.
   const Points updated = tomomap::test::withCabinet(samplePoints());
