@@ -10,22 +10,12 @@ MatchWorker::~MatchWorker() {
 
 AgreedTransform agreedFromMatch(const PairAt& pair, const MatchResult& r, const MapFeatures& target,
                                 const MapFeatures& source, const std::string& me) {
-  AgreedTransform t;
+  AgreedTransform t = agreedOf(r, target, source);
   t.target = pair.pair.first;
   t.source = pair.pair.second;
   t.target_version = pair.target_version;
   t.source_version = pair.source_version;
   t.computed_by = me;
-  t.reliable = r.reliable;
-  t.reason = r.reason;
-  t.T_target_source = r.T_target_source;
-  t.target_up = target.slicedUp();
-  t.source_up = source.slicedUp();
-  t.T_target_source_6dof = r.T_target_source_6dof;
-  t.support = r.support;
-  t.runner_up_support = r.runner_up_support;
-  t.inliers = static_cast<uint32_t>(r.inliers);
-  t.spread = {r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z()};
   return t;
 }
 

@@ -17,5 +17,6 @@ Command addEvalCommand(CLI::App& app);
 Command addVizCommand(CLI::App& app);
 Command addStatusCommand(CLI::App& app);
 Command addFleetKeysCommand(CLI::App& app);
+Command addMergeCommand(CLI::App& app);
 
 }  // namespace tomomap::cli

@@ -15,7 +15,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("-V,--version", "tomomap " TOMOMAP_VERSION);
   app.require_subcommand(1, 1);
   const std::vector<Command> commands{addMatchCommand(app), addSynthCommand(app),  addEvalCommand(app),
-                                      addVizCommand(app),   addStatusCommand(app), addFleetKeysCommand(app)};
+                                      addVizCommand(app),   addStatusCommand(app), addFleetKeysCommand(app),
+                                      addMergeCommand(app)};
   return parseAndRun(app, argc, argv, [&] {
     for (const auto& c : commands)
       if (c.app->parsed()) return c.run();

@@ -7,6 +7,7 @@
 #include <optional>
 #include <unordered_map>
 
+#include "lattice.hpp"
 #include "text.hpp"
 
 namespace tomomap {
@@ -54,17 +55,11 @@ std::vector<Patch> flatPatches(const Points& map, size_t stride, const Eigen::Ma
     Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
     size_t n = 0;
   };
-  const auto key = [side](const Eigen::Vector3f& p) {
-    const auto cell = [side](float v) {
-      return static_cast<uint64_t>(static_cast<int64_t>(std::floor(v / side)) & 0x1FFFFF);
-    };
-    return (cell(p.z()) << 42) | (cell(p.y()) << 21) | cell(p.x());
-  };
   std::unordered_map<uint64_t, Sums> cubes;
   const bool turned = !turn.isIdentity(0.0f);
   for (size_t i = 0; i < map.size(); i += stride) {
     const Eigen::Vector3f p = turned ? Eigen::Vector3f(turn * map[i]) : map[i];
-    Sums& s = cubes[key(p)];
+    Sums& s = cubes[latticeKey(p, side)];
     const Eigen::Vector3d q = p.cast<double>();
     s.sum += q;
     s.outer += q * q.transpose();

@@ -128,6 +128,12 @@ void savePcd(const std::string& path, const Points& points, PcdData data) {
   if (!pclIo().savePcd(path, points, data == PcdData::binary_compressed, &error)) throw InputError(error);
 }
 
+void saveLabelledPcd(const std::string& path, const Points& points, const std::vector<uint32_t>& labels,
+                     const std::vector<uint32_t>& colours) {
+  std::string error;
+  if (!pclIo().saveLabelledPcd(path, points, labels, colours, &error)) throw InputError(error);
+}
+
 Eigen::Matrix4d loadPoseFile(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open pose file");

@@ -31,6 +31,12 @@ enum class PcdData { binary, binary_compressed };
 /// Writes a PCD (x y z float). Throws InputError on failure.
 void savePcd(const std::string& path, const Points& points, PcdData data = PcdData::binary);
 
+/// Writes a binary PCD of x y z rgb label (PCL's PointXYZRGBL, what RViz
+/// colours by): each point's label and its label's colour (`colours[label]`,
+/// 0xRRGGBB). Throws InputError if it cannot be written.
+void saveLabelledPcd(const std::string& path, const Points& points, const std::vector<uint32_t>& labels,
+                     const std::vector<uint32_t>& colours);
+
 /// Reads a pose file: 12 numbers, the top 3x4 of a 4x4 map-to-world matrix,
 /// row-major. Throws InputError naming the file and the problem.
 Eigen::Matrix4d loadPoseFile(const std::string& path);

@@ -87,7 +87,31 @@ bool savePcd(const std::string& path, const Points& points, bool compressed, std
   return false;
 }
 
-constexpr PclIo kFunctions{&load, &savePcd};
+bool saveLabelledPcd(const std::string& path, const Points& points, const std::vector<uint32_t>& labels,
+                     const std::vector<uint32_t>& colours, std::string* error) try {
+  silencePcl();
+  pcl::PointCloud<pcl::PointXYZRGBL> cloud;
+  cloud.reserve(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    pcl::PointXYZRGBL p;
+    p.x = points[i].x();
+    p.y = points[i].y();
+    p.z = points[i].z();
+    p.label = labels.at(i);
+    p.rgba = 0xff000000u | colours.at(labels[i]);
+    cloud.push_back(p);
+  }
+  if (cloud.empty() || pcl::io::savePCDFileBinary(path, cloud) < 0) {
+    *error = path + ": cannot write map";
+    return false;
+  }
+  return true;
+} catch (const std::exception& e) {
+  *error = path + ": cannot write map: " + e.what();
+  return false;
+}
+
+constexpr PclIo kFunctions{&load, &savePcd, &saveLabelledPcd};
 
 }  // namespace
 }  // namespace tomomap

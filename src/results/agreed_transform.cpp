@@ -25,6 +25,21 @@ uint64_t parseVersion(const std::string& text) {
   return std::stoull(text, nullptr, 16);
 }
 
+AgreedTransform agreedOf(const MatchResult& r, const MapFeatures& target, const MapFeatures& source) {
+  AgreedTransform t;
+  t.reliable = r.reliable;
+  t.reason = r.reason;
+  t.T_target_source = r.T_target_source;
+  t.target_up = target.slicedUp();
+  t.source_up = source.slicedUp();
+  t.T_target_source_6dof = r.T_target_source_6dof;
+  t.support = r.support;
+  t.runner_up_support = r.runner_up_support;
+  t.inliers = static_cast<uint32_t>(r.inliers);
+  t.spread = {r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z()};
+  return t;
+}
+
 Eigen::Matrix4d AgreedTransform::ownFrames() const {
   return T_target_source_6dof.value_or(betweenOwnFrames(T_target_source.matrix(), target_up, source_up));
 }

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/matcher.hpp"
 #include "core/types.hpp"
 
 namespace tomomap {
@@ -58,6 +59,11 @@ struct AgreedTransform {
     return target_version == target_v && source_version == source_v;
   }
 };
+
+/// What a match says of a pair (reliable or why not, the transform, both
+/// maps' ups, quality); the pair's ids, versions and who computed it when
+/// are the caller's to set.
+AgreedTransform agreedOf(const MatchResult& r, const MapFeatures& target, const MapFeatures& source);
 
 /// A 4x4 matrix as four rows.
 nlohmann::json matrixJson(const Eigen::Matrix4d& M);

@@ -7,6 +7,7 @@
 #include <unordered_set>
 
 #include "core/gravity.hpp"
+#include "core/lattice.hpp"
 #include "core/voxel_filter.hpp"
 
 namespace tomomap::synth {
@@ -29,10 +30,7 @@ Points transformed(const Points& in, const Eigen::Matrix4d& T) {
 
 std::unordered_set<uint64_t> cubesOf(const Points& world) {
   std::unordered_set<uint64_t> cubes;
-  const auto cell = [](float v) {
-    return static_cast<uint64_t>(static_cast<int64_t>(std::floor(v / kOverlapCube)) & 0x1FFFFF);
-  };
-  for (const auto& p : world) cubes.insert((cell(p.z()) << 42) | (cell(p.y()) << 21) | cell(p.x()));
+  for (const auto& p : world) cubes.insert(latticeKey(p, kOverlapCube));
   return cubes;
 }
 

@@ -200,7 +200,8 @@ void Ros2Node::publishTfStatic(const std::vector<TfFrame>& frames) {
     t.transform().translation().x(f.T_parent_child(0, 3));
     t.transform().translation().y(f.T_parent_child(1, 3));
     t.transform().translation().z(f.T_parent_child(2, 3));
-    const Eigen::Quaterniond r(Eigen::Matrix3d(f.T_parent_child.topLeftCorner<3, 3>()));
+    Eigen::Quaterniond r(Eigen::Matrix3d(f.T_parent_child.topLeftCorner<3, 3>()));
+    if (r.w() < 0) r.coeffs() *= -1.0;  // one of the two: w >= 0, a turn of at most half a circle
     t.transform().rotation().x(r.x());
     t.transform().rotation().y(r.y());
     t.transform().rotation().z(r.z());

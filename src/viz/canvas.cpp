@@ -126,6 +126,44 @@ cv::Mat stack(const std::vector<cv::Mat>& images, bool vertical) {
   return out;
 }
 
+cv::Mat framePlanView(const cv::Mat& plot, const Eigen::Vector2d& lo, double px,
+                      const std::vector<std::string>& caption,
+                      const std::vector<std::pair<std::string, cv::Scalar>>& legend) {
+  const int w = plot.cols, h = plot.rows;
+  const int margin_l = 80, margin_t = 64 + 24 * static_cast<int>(caption.size()), margin_b = 60;
+  const int margin_r = std::max(30, 1100 - margin_l - w);  // room for the caption
+  cv::Mat img(h + margin_t + margin_b, w + margin_l + margin_r, CV_8UC3, colour::kWhite);
+  plot.copyTo(img(cv::Rect(margin_l, margin_t, w, h)));
+  cv::rectangle(img, cv::Rect(margin_l - 1, margin_t - 1, w + 2, h + 2), colour::kGrey, 1);
+
+  for (size_t i = 0; i < caption.size(); ++i)
+    drawText(img, caption[i], {margin_l, 26 + 24 * static_cast<int>(i)}, 0.55, colour::kBlack, Align::Left,
+             i == 0 ? 2 : 1);
+  // Metre ticks on both axes.
+  const ValueAxis xa{lo.x(), lo.x() + w * px, false, 0, 0}, ya{lo.y(), lo.y() + h * px, false, 0, 0};
+  for (double x : xa.ticks()) {
+    const int u = margin_l + static_cast<int>((x - lo.x()) / px);
+    cv::line(img, {u, margin_t + h}, {u, margin_t + h + 6}, colour::kBlack);
+    drawText(img, tickLabel(std::round(x * 100) / 100), {u, margin_t + h + 22}, 0.42, colour::kBlack, Align::Centre);
+  }
+  for (double y : ya.ticks()) {
+    const int v = margin_t + h - 1 - static_cast<int>((y - lo.y()) / px);
+    cv::line(img, {margin_l - 6, v}, {margin_l, v}, colour::kBlack);
+    drawText(img, tickLabel(std::round(y * 100) / 100), {margin_l - 9, v + 5}, 0.42, colour::kBlack, Align::Right);
+  }
+  drawText(img, "x [m]", {margin_l + w / 2, margin_t + h + 44}, 0.5, colour::kBlack, Align::Centre);
+  drawVerticalText(img, "y [m]", {18, margin_t + h / 2}, 0.5);
+  // Legend, under the caption.
+  int lx = margin_l;
+  const int ly = margin_t - 18;
+  for (const auto& [name, col] : legend) {
+    cv::rectangle(img, cv::Rect(lx, ly - 11, 14, 12), col, cv::FILLED);
+    drawText(img, name, {lx + 20, ly}, 0.45);
+    lx += 40 + 9 * static_cast<int>(name.size());
+  }
+  return img;
+}
+
 void writePng(const std::string& path, const cv::Mat& img) {
   // libpng's simplified API, not OpenCV's imgcodecs: that one links GDAL and
   // ~140 libraries, which doubled the start-up time and memory of `tomomap`.

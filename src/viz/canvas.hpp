@@ -1,8 +1,10 @@
 #pragma once
 // Small drawing vocabulary shared by every picture tomomap writes: text, dashed
 // lines, axes with ticks. OpenCV does the rasterising.
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tomomap::viz {
@@ -45,6 +47,13 @@ std::string tickLabel(double v);
 
 /// Stacks images vertically (or horizontally), padding the narrower ones with white.
 cv::Mat stack(const std::vector<cv::Mat>& images, bool vertical = true);
+
+/// A map seen from above (`plot`: `px` metres a pixel, its bottom-left pixel
+/// at `lo`, x right and y up) framed with metre ticks on both axes, the
+/// caption's lines above (the first in bold) and a legend of colours under them.
+cv::Mat framePlanView(const cv::Mat& plot, const Eigen::Vector2d& lo, double px,
+                      const std::vector<std::string>& caption,
+                      const std::vector<std::pair<std::string, cv::Scalar>>& legend);
 
 /// Writes a PNG; throws InputError naming the path if it cannot.
 void writePng(const std::string& path, const cv::Mat& img);

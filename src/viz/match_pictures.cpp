@@ -74,45 +74,17 @@ cv::Mat drawOverlay(const SliceStack& target, const SliceStack& source, const Po
   plot(t_xy, t_mask);
   plot(s_xy, s_mask);
 
-  const int margin_l = 80, margin_t = 64 + 24 * static_cast<int>(caption.size()), margin_b = 60;
-  const int margin_r = std::max(30, 1100 - margin_l - w);  // room for the caption
-  cv::Mat img(h + margin_t + margin_b, w + margin_l + margin_r, CV_8UC3, colour::kWhite);
-  cv::Mat plot_area = img(cv::Rect(margin_l, margin_t, w, h));
+  cv::Mat image(h, w, CV_8UC3, colour::kWhite);
   const cv::Vec3b blue(178, 114, 0), orange(0, 140, 230), both(60, 40, 40);
   for (int v = 0; v < h; ++v)
     for (int u = 0; u < w; ++u) {
       const bool a = t_mask.at<uint8_t>(v, u), b = s_mask.at<uint8_t>(v, u);
-      if (a || b) plot_area.at<cv::Vec3b>(v, u) = a && b ? both : a ? blue : orange;
+      if (a || b) image.at<cv::Vec3b>(v, u) = a && b ? both : a ? blue : orange;
     }
-  cv::rectangle(img, cv::Rect(margin_l - 1, margin_t - 1, w + 2, h + 2), colour::kGrey, 1);
-
-  for (size_t i = 0; i < caption.size(); ++i)
-    drawText(img, caption[i], {margin_l, 26 + 24 * static_cast<int>(i)}, 0.55, colour::kBlack, Align::Left,
-             i == 0 ? 2 : 1);
-  // Metre ticks on both axes.
-  const ValueAxis xa{lo.x(), lo.x() + w * px, false, 0, 0}, ya{lo.y(), lo.y() + h * px, false, 0, 0};
-  for (double x : xa.ticks()) {
-    const int u = margin_l + static_cast<int>((x - lo.x()) / px);
-    cv::line(img, {u, margin_t + h}, {u, margin_t + h + 6}, colour::kBlack);
-    drawText(img, tickLabel(std::round(x * 100) / 100), {u, margin_t + h + 22}, 0.42, colour::kBlack, Align::Centre);
-  }
-  for (double y : ya.ticks()) {
-    const int v = margin_t + h - 1 - static_cast<int>((y - lo.y()) / px);
-    cv::line(img, {margin_l - 6, v}, {margin_l, v}, colour::kBlack);
-    drawText(img, tickLabel(std::round(y * 100) / 100), {margin_l - 9, v + 5}, 0.42, colour::kBlack, Align::Right);
-  }
-  drawText(img, "x [m]", {margin_l + w / 2, margin_t + h + 44}, 0.5, colour::kBlack, Align::Centre);
-  drawVerticalText(img, "y [m]", {18, margin_t + h / 2}, 0.5);
-  // Legend, under the caption.
-  int lx = margin_l;
-  const int ly = margin_t - 18;
-  for (const auto& [name, col] :
-       {std::pair<std::string, cv::Vec3b>{"target", blue}, {"source (aligned)", orange}, {"both", both}}) {
-    cv::rectangle(img, cv::Rect(lx, ly - 11, 14, 12), cv::Scalar(col[0], col[1], col[2]), cv::FILLED);
-    drawText(img, name, {lx + 20, ly}, 0.45);
-    lx += 40 + 9 * static_cast<int>(name.size());
-  }
-  return img;
+  return framePlanView(image, lo, px, caption,
+                       {{"target", colour::kSeries[0]},
+                        {"source (aligned)", colour::kSeries[1]},
+                        {"both", cv::Scalar(both[0], both[1], both[2])}});
 }
 
 cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, const MatchResult& r, int count,

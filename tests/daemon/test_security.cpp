@@ -308,6 +308,7 @@ TEST(Identity, AnOccupancyBombInAPeersNameStaysWithinTheMemoryBudget) {
   a.height(kSide);
   a.slice_count(kSlices);
   a.raw_bytes(1u << 30);
+  a.up({0.0, 0.0, 1.0});
   a.features().max_features(1000);
   a.features().fast_threshold(20);
   a.features().pad(16);

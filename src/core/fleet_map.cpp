@@ -1,0 +1,70 @@
+#include "fleet_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <unordered_set>
+
+#include "lattice.hpp"
+
+namespace tomomap {
+FleetMap mergeMaps(const std::vector<PlacedMap>& maps, double grid) {
+  if (!(grid > 0)) throw InputError("the fleet map's grid must be positive");
+  FleetMap out;
+  out.grid = grid;
+  std::unordered_set<uint64_t> seen;
+  for (uint32_t m = 0; m < maps.size(); ++m) {
+    out.agents.push_back(maps[m].agent);
+    std::unordered_set<uint64_t> own;  // this map's cells, counted once
+    const Eigen::Matrix4d& T = maps[m].T_root_map;
+    for (const Eigen::Vector3f& c : maps[m].cells) {
+      const Eigen::Vector3f p = (T.topLeftCorner<3, 3>() * c.cast<double>() + T.topRightCorner<3, 1>()).cast<float>();
+      const uint64_t key = latticeKey(p, grid);
+      own.insert(key);
+      if (seen.insert(key).second) {
+        out.points.push_back(latticeCentre(p, grid));
+        out.robot.push_back(m);
+      }
+    }
+    out.cells_of.push_back(own.size());
+  }
+  return out;
+}
+
+double floorHeight(const FleetMap& map) {
+  if (map.points.empty()) return NAN;
+  std::map<int64_t, size_t> layers;  // by height
+  for (const auto& p : map.points) ++layers[static_cast<int64_t>(std::floor(p.z() / map.grid))];
+  size_t fullest = 0;
+  for (const auto& [layer, cells] : layers) fullest = std::max(fullest, cells);
+  for (const auto& [layer, cells] : layers)
+    if (2 * cells >= fullest) return (static_cast<double>(layer) + 0.5) * map.grid;
+  return NAN;  // not reached: the fullest layer qualifies
+}
+
+OccupancyGrid2D occupancyGrid(const FleetMap& map, double z_low, double z_high) {
+  OccupancyGrid2D g;
+  g.resolution = map.grid;
+  if (map.points.empty()) return g;
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(INFINITY), hi = -lo;
+  for (const auto& p : map.points) {
+    lo = lo.cwiseMin(p.head<2>().cast<double>());
+    hi = hi.cwiseMax(p.head<2>().cast<double>());
+  }
+  // The points are cell centres: the grid's cells are the lattice's.
+  g.x_min = std::floor(lo.x() / map.grid) * map.grid;
+  g.y_min = std::floor(lo.y() / map.grid) * map.grid;
+  g.width = static_cast<int>(std::lround((hi.x() - g.x_min) / map.grid + 0.5));
+  g.height = static_cast<int>(std::lround((hi.y() - g.y_min) / map.grid + 0.5));
+  g.cells.assign(static_cast<size_t>(g.width) * static_cast<size_t>(g.height), OccupancyGrid2D::kUnknown);
+  for (const auto& p : map.points) {
+    if (p.z() < z_low || p.z() > z_high) continue;
+    const int column = std::clamp(static_cast<int>((p.x() - g.x_min) / map.grid), 0, g.width - 1);
+    const int row = std::clamp(static_cast<int>((p.y() - g.y_min) / map.grid), 0, g.height - 1);
+    g.cells[static_cast<size_t>(row) * static_cast<size_t>(g.width) + static_cast<size_t>(column)] =
+        OccupancyGrid2D::kOccupied;
+  }
+  return g;
+}
+
+}  // namespace tomomap
