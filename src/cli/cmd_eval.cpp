@@ -397,23 +397,30 @@ Command addEvalCommand(CLI::App& app) {
       app.add_subcommand("eval", "Run every pair of a suite through tomomap and the methods it is measured against.");
   sub->add_option("SUITE", o->suite, "suite file (TOML): [[pair]], [[synth]], [[scan]] and [[sequence]] tables");
   // A user's own SLAM output: how tomomap would do on their robots' maps.
-  sub->add_option("--scans", o->sequence.scans,
-                  "instead of a suite: a folder of keyframe scans (one .pcd/.ply/.xyz a keyframe, in name order), "
-                  "cut into two robots' maps per pair")
-      ->check(CLI::ExistingDirectory);
+  CLI::Option* scans =
+      sub->add_option("--scans", o->sequence.scans,
+                      "instead of a suite: a folder of keyframe scans (one .pcd/.ply/.xyz a keyframe, in name order), "
+                      "cut into two robots' maps per pair")
+          ->check(CLI::ExistingDirectory);
+  // Said, not ignored, beside a suite file.
   sub->add_option("--poses", o->sequence.poses, "the keyframes' poses (KITTI, TUM or FAST-LIO's format), one a scan")
-      ->check(CLI::ExistingFile);
+      ->check(CLI::ExistingFile)
+      ->needs(scans);
   sub->add_option("--pairs", o->sequence_pairs, "with --scans: how many pairs to cut (seeds 1..N)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 1000));
+      ->check(CLI::Range(1, 1000))
+      ->needs(scans);
   sub->add_option("-g,--grid", o->sequence.grid, "with --scans: grid size to match at [m]")
       ->capture_default_str()
-      ->check(gridSize());
+      ->check(gridSize())
+      ->needs(scans);
   sub->add_flag("--level", o->sequence.level,
-                "with --scans: level each map (as if the SLAM saved it gravity-aligned) instead of leaning as saved");
+                "with --scans: level each map (as if the SLAM saved it gravity-aligned) instead of leaning as saved")
+      ->needs(scans);
   sub->add_option("--range", o->sequence.range, "with --scans: each scan's points kept within this range [m]")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->needs(scans);
   sub->add_option("-o,--out", o->out, "output directory (rows.csv, rows.jsonl, summary.md, boxplots.png, worlds/)")
       ->capture_default_str();
   sub->add_option("-m,--methods", o->methods, "override the suite's methods (tomomap, fpfh-ransac, paper-consensus)")

@@ -289,4 +289,8 @@ TEST(Eval, APosedSequenceOfAUsersScansIsCutIntoPairsAndJudged) {
       runTomomap("eval --scans " + (dir / "scans") + " --poses " + (dir / "short.txt") + " -o " + (dir / "bad"));
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_NE(bad.output.find("24 scans (.pcd, .ply, .xyz), but"), std::string::npos) << bad.output;
+  // A sequence's options beside a suite file are said, not ignored.
+  const auto beside = runTomomap("eval " + (dir / "s.toml") + " --pairs 3 -o " + (dir / "beside"));
+  EXPECT_EQ(beside.exit_code, 2) << beside.output;
+  EXPECT_NE(beside.output.find("--pairs requires --scans"), std::string::npos) << beside.output;
 }
