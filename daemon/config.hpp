@@ -19,7 +19,11 @@ struct Ros2Config {
   int domain = 0;                     ///< the ROS 2 nodes' ROS_DOMAIN_ID
   std::string frame = "{agent}/map";  ///< frame id of each agent's map; {agent} is replaced by its id
   std::string root;                   ///< the tree's root agent; empty: the lowest id in the fleet
-  bool localhost_only = true;         ///< reach ROS 2 nodes on this robot only, never the robots' link
+  /// A frame above every map (map_merge_3d's `world`): each placed map hangs
+  /// from it with its pose in the root's map, the root's the identity; empty:
+  /// the root's map is the tree's root.
+  std::string world;
+  bool localhost_only = true;  ///< reach ROS 2 nodes on this robot only, never the robots' link
   /// A sensor_msgs/PointCloud2 topic that carries this robot's map (its SLAM's
   /// map cloud), instead of the `map` file; empty: the file.
   std::string map_topic;

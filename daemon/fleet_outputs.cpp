@@ -63,12 +63,17 @@ void FleetOutputs::handTree(const Config& config) {
   std::vector<TreeEdge> tree = treeOf(frame_, config.treeRoot(), stamp_ms);
   if (published_ && sameTree(tree, *published_)) return;
   std::vector<transport::TfFrame> frames;
+  const std::string& world = config.ros2.world;
+  // Under a world frame the root's map is one child among the others, where the root is.
+  if (!world.empty() && frame_.pose(config.treeRoot()))
+    frames.push_back({world, config.ros2.frameOf(config.treeRoot()), Eigen::Matrix4d::Identity(), stamp_ms});
   for (const auto& e : tree)
-    frames.push_back({config.ros2.frameOf(e.parent), config.ros2.frameOf(e.child), e.ownFrames(), e.stamp_ms});
+    frames.push_back({world.empty() ? config.ros2.frameOf(e.parent) : world, config.ros2.frameOf(e.child),
+                      e.ownFrames(), e.stamp_ms});
   publish_(frames);
-  log_.info("ROS 2: /tf_static holds " + std::to_string(frames.size()) + " of the fleet's " +
+  log_.info("ROS 2: /tf_static holds " + std::to_string(tree.size()) + " of the fleet's " +
             std::to_string(config.transport.peers.size()) + " other frames under " +
-            config.ros2.frameOf(config.treeRoot()));
+            config.ros2.frameOf(config.treeRoot()) + (world.empty() ? "" : ", every map under " + world));
   published_ = std::move(tree);
 }
 

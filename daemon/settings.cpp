@@ -276,6 +276,18 @@ std::vector<Setting> declare() {
     s.shown = [](const Config& c) { return c.treeRoot(); };
     bindField(s, [](Config& c) { return &c.ros2.root; });
   }
+  {
+    Setting& s = d("ros2.world", K::Text, "", Reload::RestartsRos2,
+                   "a frame above every map, as multi-robot map mergers name it (e.g. `world`): every placed map "
+                   "hangs from it with its pose in the root's map (the root's the identity), so the root's map is "
+                   "one child among others");
+    s.default_text = "none: the root's map is the tree's root";
+    s.check = [](const V& v) -> Check {
+      if (text(v).find("{agent}") == std::string::npos && text(v).find(' ') == std::string::npos) return std::nullopt;
+      return "must be one frame id, without {agent} or spaces";
+    };
+    bindField(s, [](Config& c) { return &c.ros2.world; });
+  }
   bindField(d("ros2.localhost_only", K::Flag, "", Reload::RestartsRos2,
               "reach ROS 2 nodes on this robot only, under any ROS 2 discovery setting that keeps them on it "
               "(`ROS_LOCALHOST_ONLY=1`, Jazzy's `LOCALHOST`, static peers on this host), and send nothing to "

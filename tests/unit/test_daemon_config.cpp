@@ -111,6 +111,18 @@ TEST(DaemonConfig, AMapsKnownUpIsThreeNumbersAndLeavesTheEstimateAlone) {
   }
 }
 
+TEST(DaemonConfig, AWorldFrameIsOneFrameId) {
+  TempDir dir;
+  const std::string base = "agent = \"alpha\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n[ros2]\n";
+  std::ofstream(dir / "c.toml") << base << "world = \"world\"\n";
+  EXPECT_EQ(loadConfig(dir / "c.toml").ros2.world, "world");
+  std::ofstream(dir / "c.toml") << base;
+  EXPECT_EQ(loadConfig(dir / "c.toml").ros2.world, "") << "none unless asked: the root's map is the tree's root";
+  const std::string e = errorOf(dir, base + "world = \"{agent}/world\"\n");
+  EXPECT_NE(e.find("c.toml:5:"), std::string::npos) << e;
+  EXPECT_NE(e.find("'ros2.world': must be one frame id"), std::string::npos) << e;
+}
+
 TEST(DaemonConfig, TheRos2TableTurnsTfStaticOnWithFramesAndARootFromTheFleet) {
   TempDir dir;
   const std::string base = "agent = \"bravo\"\nmap = \"a.pcd\"\ndiscovery_port = 17500\n";

@@ -87,6 +87,20 @@ TEST(FleetOutputs, TheFilesHoldTheFrameAndTheTreeIsHandedOnOnlyWhenItChanges) {
   EXPECT_EQ(agent["agent"], "bravo");
   EXPECT_NEAR(agent["up"][0].get<double>(), bravo_up.x(), 1e-12);
   EXPECT_NEAR(agent["T_reference_agent_6dof"][0][3].get<double>(), 1.5, 1e-9);
+
+  // Under a world frame (map_merge_3d's convention) every map hangs from it, the root's as the identity.
+  Config under_world = config;
+  under_world.ros2.world = "world";
+  outputs.setTreePublisher([&](const auto& frames) { handed.push_back(frames); });
+  outputs.update({leaning}, under_world);
+  ASSERT_EQ(handed.size(), 5u);
+  ASSERT_EQ(handed[4].size(), 2u);
+  EXPECT_EQ(handed[4][0].parent, "world");
+  EXPECT_EQ(handed[4][0].child, "alpha/map");
+  EXPECT_TRUE(handed[4][0].T_parent_child.isIdentity(0.0));
+  EXPECT_EQ(handed[4][1].parent, "world");
+  EXPECT_EQ(handed[4][1].child, "bravo/map");
+  EXPECT_TRUE(handed[4][1].T_parent_child.isApprox(T, 1e-12)) << "bravo's pose in the root's map";
 }
 
 TEST(FleetOutputs, AFailedWriteIsSaidAndRetriedUntilItWorks) {
