@@ -159,6 +159,11 @@ void checkTogether(const Reader& r, const toml::table& root,
     if (!ros->get("enabled")) c.ros2.enabled = true;
     if (!c.ros2.root.empty() && !c.inFleet(c.ros2.root))
       r.fail(*ros->get("root"), "ros2.root", "'" + c.ros2.root + "' is neither this agent nor one of its peers");
+    std::vector<std::string> fleet = c.peerIds();
+    fleet.push_back(c.agent());
+    for (const auto& agent : fleet)  // a frame cannot hang from itself
+      if (!c.ros2.world.empty() && c.ros2.frameOf(agent) == c.ros2.world)
+        r.fail(*ros->get("world"), "ros2.world", "'" + c.ros2.world + "' is " + agent + "'s map frame");
     if (!c.ros2.map_topic.empty()) {
       if (!c.ros2.enabled) r.fail(*ros->get("map_topic"), "ros2.map_topic", "needs [ros2] enabled");
       if (!c.map.empty())

@@ -64,12 +64,18 @@ void FleetOutputs::handTree(const Config& config) {
   if (published_ && sameTree(tree, *published_)) return;
   std::vector<transport::TfFrame> frames;
   const std::string& world = config.ros2.world;
-  // Under a world frame the root's map is one child among the others, where the root is.
-  if (!world.empty() && frame_.pose(config.treeRoot()))
-    frames.push_back({world, config.ros2.frameOf(config.treeRoot()), Eigen::Matrix4d::Identity(), stamp_ms});
+  // Under a world frame the root's map is one child among the others, where
+  // the root is; the world is the root's map levelled (z up, even where the
+  // root's map leans).
+  Eigen::Matrix4d level = Eigen::Matrix4d::Identity();
+  const AgentPose* root = frame_.pose(config.treeRoot());
+  if (!world.empty() && root) {
+    level.topLeftCorner<3, 3>() = levelingOf(root->up).toRotationMatrix();
+    frames.push_back({world, config.ros2.frameOf(config.treeRoot()), level, stamp_ms});
+  }
   for (const auto& e : tree)
     frames.push_back({world.empty() ? config.ros2.frameOf(e.parent) : world, config.ros2.frameOf(e.child),
-                      e.ownFrames(), e.stamp_ms});
+                      level * e.ownFrames(), e.stamp_ms});
   publish_(frames);
   log_.info("ROS 2: /tf_static holds " + std::to_string(tree.size()) + " of the fleet's " +
             std::to_string(config.transport.peers.size()) + " other frames under " +

@@ -35,9 +35,7 @@ Clock::duration MapSender::leaveTime(size_t bytes) const {
       std::chrono::duration<double>(static_cast<double>(bytes) / transport::bytesPerSecond(kbps_)));
 }
 
-size_t MapSender::bundleBytes(size_t bundle) const {
-  return transport::Bus::serializedSize(offer_.bundles[bundle]);
-}
+size_t MapSender::bundleBytes(size_t bundle) const { return transport::Bus::serializedSize(offer_.bundles[bundle]); }
 
 size_t MapSender::request(const std::string& requester, uint64_t version, const std::vector<int32_t>& slices,
                           Clock::duration stalled, Clock::time_point now, uint64_t received_through) {
@@ -49,8 +47,7 @@ size_t MapSender::request(const std::string& requester, uint64_t version, const 
     for (const auto& e : offer_.announcement.slices()) wanted.push_back(e.slice());
   else
     for (int32_t k : slices)
-      if (offer_.bundles_of.count(k) && std::find(wanted.begin(), wanted.end(), k) == wanted.end())
-        wanted.push_back(k);
+      if (offer_.bundles_of.count(k) && std::find(wanted.begin(), wanted.end(), k) == wanted.end()) wanted.push_back(k);
 
   // Within the requester's window the copies written are still on their way
   // (live, repaired, or from the history if it matched late): only slices

@@ -7,7 +7,9 @@
 #include <regex>
 #include <sstream>
 
+#include "core/gravity.hpp"
 #include "core/match_settings.hpp"
+#include "core/text.hpp"
 
 namespace tomomap::daemon {
 namespace {
@@ -126,13 +128,20 @@ std::vector<Setting> declare() {
   {
     Setting& s = d("map_up", K::Text, "X, Y, Z", Reload::AtOnce,
                    "the map's up direction in its own frame where it is known (its SLAM's gravity estimate, an "
-                   "IMU's), e.g. \"0.05, -0.02, 1\": the map is levelled by it instead of by the estimate read off "
+                   "IMU's), e.g. \"0.05, -0.02, 1\", within 30 deg of z: the map is levelled by it instead of by the "
+                   "estimate read off "
                    "its floors (docs/operations.md, \"Maps that lean\")");
     s.default_text = "none: estimated";
     s.shown = [](const Config& c) { return c.map_up ? directionText(*c.map_up) : "(none: estimated)"; };
     s.check = [](const V& v) -> Check {
-      if (direction(text(v))) return std::nullopt;
-      return "must be a non-zero direction \"X, Y, Z\" (three numbers separated by commas)";
+      const auto up = direction(text(v));
+      if (!up) return "must be a non-zero direction \"X, Y, Z\" (three numbers separated by commas)";
+      // What peers accept (levelableUp): a map levelled further is refused by every one of them.
+      if (!levelableUp(up->normalized()))
+        return "leans " + fixed(degrees(std::acos(std::clamp(up->normalized().z(), -1.0, 1.0))), 1) +
+               " deg from z: a map is levelled by at most " + fixed(degrees(kMaxLevelable), 0) +
+               " deg (its axes may be swapped: give its frame's up, z of the map's frame turned)";
+      return std::nullopt;
     };
     s.get = [](const Config& c) -> V { return c.map_up ? directionText(*c.map_up) : std::string(); };
     s.set = [](Config& c, const V& v) { c.map_up = direction(text(v)); };

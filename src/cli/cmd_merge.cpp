@@ -52,29 +52,46 @@ std::vector<NamedMap> namedMaps(const std::vector<std::string>& args) {
   return maps;
 }
 
-/// The frame's poses between the maps' own frames: p_reference = T * p_agent.
-std::map<std::string, Eigen::Matrix4d> ownFramePoses(const FleetFrame& frame) {
+/// The rotation that levels a map whose up is `up`, as a 4x4.
+Eigen::Matrix4d leveling(const Eigen::Vector3d& up) {
+  Eigen::Matrix4d L = Eigen::Matrix4d::Identity();
+  L.topLeftCorner<3, 3>() = levelingOf(up).toRotationMatrix();
+  return L;
+}
+
+/// The frame's poses in the reference's map levelled (z up, so that the 2D
+/// grid's heights mean something even where the reference's map leans):
+/// p_reference_levelled = T * p_agent.
+std::map<std::string, Eigen::Matrix4d> levelPoses(const FleetFrame& frame) {
   std::map<std::string, Eigen::Matrix4d> poses;
-  if (frame.poses.empty()) return poses;
-  const Eigen::Vector3d& reference_up = frame.poses.front().up;
-  for (const auto& p : frame.poses) poses[p.agent] = betweenOwnFrames(p.T_reference_agent.matrix(), reference_up, p.up);
+  const AgentPose* reference = frame.pose(frame.reference);
+  if (!reference) return poses;
+  for (const auto& p : frame.poses) poses[p.agent] = leveling(reference->up) * frame.ownFramePose(p);
   return poses;
 }
 
-/// The poses a daemon's frame.json gives, and its reference.
+/// The same from a daemon's frame.json, and its reference.
 std::pair<std::string, std::map<std::string, Eigen::Matrix4d>> readFrameFile(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open");
   try {
     const auto j = nlohmann::json::parse(in);
+    const std::string reference = j.at("reference").get<std::string>();
     std::map<std::string, Eigen::Matrix4d> poses;
+    Eigen::Vector3d reference_up = Eigen::Vector3d::UnitZ();
     for (const auto& a : j.at("agents")) {
       const std::string agent = a.at("agent").get<std::string>();
-      // Files of daemons from before maps were levelled hold the 4-DoF pose alone.
+      // Files of daemons from before maps were levelled hold the 4-DoF pose alone, and no up.
       poses[agent] = a.contains("T_reference_agent_6dof") ? matrixFromJson(a.at("T_reference_agent_6dof"))
                                                           : matrixFromJson(a.at("T_reference_agent").at("matrix"));
+      if (agent == reference && a.contains("up")) {
+        const auto up = a.at("up").get<std::array<double, 3>>();
+        reference_up = {up[0], up[1], up[2]};
+        if (!levelableUp(reference_up)) throw InputError(reference + "'s up is not a unit vector within 30 deg of z");
+      }
     }
-    return {j.at("reference").get<std::string>(), poses};
+    for (auto& [agent, T] : poses) T = leveling(reference_up) * T;
+    return {reference, poses};
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path + ": not a frame.json: " + e.what());
   } catch (const InputError& e) {
@@ -140,7 +157,7 @@ int runMerge(const MergeOptions& o) {
     if (maps.size() < 2) throw InputError("give two maps or more to match, or a frame.json (--frame) to place one");
     const FleetFrame frame = matchAll(maps, features, o.params);
     reference = frame.reference;
-    poses = ownFramePoses(frame);
+    poses = levelPoses(frame);
   }
 
   std::vector<PlacedMap> placed;
@@ -174,14 +191,14 @@ int runMerge(const MergeOptions& o) {
   for (size_t r = 0; r < merged.agents.size(); ++r)
     counts += (r ? ", " : "") + merged.agents[r] + " " + std::to_string(merged.cells_of[r]);
   const std::vector<std::string> caption{
-      "The fleet's map in " + reference + "'s frame: " + std::to_string(merged.agents.size()) + " robots, " +
+      "The fleet's map in " + reference + "'s frame, levelled: " + std::to_string(merged.agents.size()) + " robots, " +
           std::to_string(merged.points.size()) + " cells at g " + fixed(o.params.grid, 2) + " m",
       "in colour: what each robot's map holds " + fixed(o.band[0], 2) + "-" + fixed(o.band[1], 2) +
           " m above the floor (z " + fixed(floor, 2) + " m); grey: the rest"};
   viz::writePng(stem + ".png", viz::drawFleetMap(merged, z_low, z_high, caption));
 
   std::cout << "fleet map        " << stem << ".pcd: " << merged.points.size() << " cells at g " << o.params.grid
-            << " m in " << reference << "'s frame (cells per robot: " << counts
+            << " m in " << reference << "'s frame, levelled (cells per robot: " << counts
             << "; fields x y z rgba label, label = the robot's place in this list)\n"
             << "2D grid          " << stem << ".pgm, " << stem << ".yaml: " << grid.width << " x " << grid.height
             << " cells, occupied where a map holds something " << fixed(o.band[0], 2) << "-" << fixed(o.band[1], 2)

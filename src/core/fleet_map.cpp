@@ -28,6 +28,12 @@ FleetMap mergeMaps(const std::vector<PlacedMap>& maps, double grid) {
     }
     out.cells_of.push_back(own.size());
   }
+  // Cells 2^21 apart share a lattice key: a map that spans that many is no fleet's map.
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(INFINITY), hi = -lo;
+  for (const auto& p : out.points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  if (!out.points.empty() && ((hi - lo).array() / static_cast<float>(grid) >= float(1 << 20)).any())
+    throw InputError("the fleet map spans more than 2^20 cells along an axis at " + std::to_string(grid) +
+                     " m: maps placed this far apart are not one place");
   return out;
 }
 
@@ -54,6 +60,11 @@ OccupancyGrid2D occupancyGrid(const FleetMap& map, double z_low, double z_high) 
   // The points are cell centres: the grid's cells are the lattice's.
   g.x_min = std::floor(lo.x() / map.grid) * map.grid;
   g.y_min = std::floor(lo.y() / map.grid) * map.grid;
+  const Eigen::Vector2d cells = (hi - Eigen::Vector2d(g.x_min, g.y_min)) / map.grid;
+  if (cells.x() * cells.y() > kMaxGridCells)
+    throw InputError("the fleet map spans " + std::to_string(std::lround(hi.x() - lo.x())) + " x " +
+                     std::to_string(std::lround(hi.y() - lo.y())) + " m: too large a 2D grid at " +
+                     std::to_string(map.grid) + " m (maps placed this far apart are not one place)");
   g.width = static_cast<int>(std::lround((hi.x() - g.x_min) / map.grid + 0.5));
   g.height = static_cast<int>(std::lround((hi.y() - g.y_min) / map.grid + 0.5));
   g.cells.assign(static_cast<size_t>(g.width) * static_cast<size_t>(g.height), OccupancyGrid2D::kUnknown);

@@ -29,7 +29,8 @@ struct FleetMap {
 };
 
 /// Places every map by its transform and merges them on the root frame's
-/// lattice of `grid` (cells with a corner at the origin): each occupied cell once.
+/// lattice of `grid` (cells with a corner at the origin): each occupied cell
+/// once. Throws InputError where they span more than 2^20 cells along an axis.
 FleetMap mergeMaps(const std::vector<PlacedMap>& maps, double grid);
 
 /// The height of the fleet map's floor (or ground) [m]: the centre of the
@@ -49,6 +50,9 @@ struct OccupancyGrid2D {
   static constexpr int8_t kOccupied = 100, kUnknown = -1;
   int8_t at(int column, int row) const { return cells[static_cast<size_t>(row) * width + column]; }
 };
+
+/// The largest 2D grid occupancyGrid makes (100 M cells, 100 MB).
+constexpr double kMaxGridCells = 1e8;
 
 /// The cells of the fleet map whose height lies in [z_low, z_high] seen from
 /// above: occupied where one is, unknown elsewhere (the slices carry where a

@@ -130,7 +130,8 @@ std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string
                              fixed(degrees(params.max_tilt), 1) + " deg)";
   if (!params.level && tilt.angle <= kMaxLevelable) return tilted + "; levelling is off: level the map first";
   return tilted + ", too far to level (limit " + fixed(degrees(kMaxLevelable), 0) +
-         " deg): its axes may be swapped (y up); fix its frame, or give its up (--up-target, --up-source)";
+         " deg): its axes may be swapped (y up); fix its frame, or give its up (--up-target, --up-source; the "
+         "daemon's map_up)";
 }
 
 MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings, size_t* filtered_points,

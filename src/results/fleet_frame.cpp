@@ -27,6 +27,11 @@ const AgentPose* FleetFrame::pose(const std::string& agent) const {
   return nullptr;
 }
 
+Eigen::Matrix4d FleetFrame::ownFramePose(const AgentPose& p) const {
+  const AgentPose* r = pose(reference);
+  return betweenOwnFrames(p.T_reference_agent.matrix(), r ? r->up : Eigen::Vector3d::UnitZ(), p.up);
+}
+
 const PairVerdict* FleetFrame::verdict(const PairKey& pair) const {
   for (const auto& v : pairs)
     if (v.pair == pair) return &v;
@@ -236,6 +241,33 @@ FleetFrame buildFleetFrame(const std::vector<AgreedTransform>& agreed, const std
   std::map<PairKey, AgreedTransform> reliable;  // one per pair, by key: the same order on every agent
   for (const auto& t : agreed)
     if (t.reliable) reliable[t.pair()] = t;
+  // One up a map: its newest link's (a map kept for an earlier version may
+  // have been levelled by another up). Every link is stated between the maps
+  // levelled by those ups, where the 4-DoF graph holds.
+  std::map<std::string, std::pair<uint64_t, Eigen::Vector3d>> newest;
+  const auto note = [&](const std::string& agent, uint64_t at, const Eigen::Vector3d& up) {
+    const auto it = newest.find(agent);
+    if (it == newest.end() || at > it->second.first) newest[agent] = {at, up};
+  };
+  for (const auto& [key, t] : reliable) {
+    note(t.target, t.computed_at_ms, t.target_up);
+    note(t.source, t.computed_at_ms, t.source_up);
+  }
+  const auto upOf = [&](const std::string& agent) {
+    const auto it = newest.find(agent);
+    return it == newest.end() ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : it->second.second;
+  };
+  for (auto& [key, t] : reliable) {
+    const Eigen::Vector3d target_up = upOf(t.target), source_up = upOf(t.source);
+    if (target_up == t.target_up && source_up == t.source_up) continue;
+    // p_target_levelled = R_target * T_own * R_source^-1 p_source_levelled: its nearest 4-DoF.
+    Eigen::Matrix4d R_target = Eigen::Matrix4d::Identity(), R_source = Eigen::Matrix4d::Identity();
+    R_target.topLeftCorner<3, 3>() = levelingOf(target_up).toRotationMatrix();
+    R_source.topLeftCorner<3, 3>() = levelingOf(source_up).toRotationMatrix();
+    t.T_target_source = Pose4::fromMatrix(R_target * t.ownFrames() * R_source.transpose());
+    t.target_up = target_up;
+    t.source_up = source_up;
+  }
   std::vector<AgreedTransform> links;
   for (auto& [key, t] : reliable) links.push_back(std::move(t));
   PairGraph g(std::move(links));
@@ -267,21 +299,6 @@ FleetFrame buildFleetFrame(const std::vector<AgreedTransform>& agreed, const std
   }
   frame.converged = optimise(g, reference, poses, limits, frame.optimised_pairs);
 
-  // Each map's up, as its best-supported link says (every link of a map's
-  // version says the same: it was announced with the map).
-  std::map<std::string, std::pair<int, Eigen::Vector3d>> ups;
-  const auto note = [&](const std::string& agent, int support, const Eigen::Vector3d& up) {
-    const auto it = ups.find(agent);
-    if (it == ups.end() || support > it->second.first) ups[agent] = {support, up};
-  };
-  for (const auto& t : kept) {
-    note(t.target, t.support, t.target_up);
-    note(t.source, t.support, t.source_up);
-  }
-  const auto upOf = [&](const std::string& agent) {
-    const auto it = ups.find(agent);
-    return it == ups.end() ? Eigen::Vector3d(Eigen::Vector3d::UnitZ()) : it->second.second;
-  };
   frame.poses.push_back({reference, poses.at(reference), upOf(reference), paths.at(reference)});
   std::set<std::string> everyone(agents.begin(), agents.end());
   for (const auto& [key, t] : reliable) everyone.insert({key.first, key.second});
@@ -311,8 +328,7 @@ nlohmann::json toJson(const FleetFrame& frame) {
     poses.push_back({{"agent", p.agent},
                      {"T_reference_agent", toJson(p.T_reference_agent)},
                      {"up", {p.up.x(), p.up.y(), p.up.z()}},
-                     {"T_reference_agent_6dof",
-                      matrixJson(betweenOwnFrames(p.T_reference_agent.matrix(), frame.poses.front().up, p.up))},
+                     {"T_reference_agent_6dof", matrixJson(frame.ownFramePose(p))},
                      {"path", p.path}});
   for (const auto& v : frame.pairs) {
     nlohmann::json j{{"pair", pairText(v.pair)}, {"verdict", consistencyName(v.verdict)}, {"cycle", v.cycle}};

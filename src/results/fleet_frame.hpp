@@ -55,6 +55,9 @@ struct FleetFrame {
   bool converged = true;                 ///< the optimiser said so (false: the poses are its last iterate)
 
   const AgentPose* pose(const std::string& agent) const;
+  /// `p`'s pose between the maps' own frames, the levellings undone:
+  /// p_reference = T * p_agent (what tf and frame.json's T_reference_agent_6dof carry).
+  Eigen::Matrix4d ownFramePose(const AgentPose& p) const;
   const PairVerdict* verdict(const PairKey& pair) const;
 };
 

@@ -109,6 +109,9 @@ TEST(DaemonConfig, AMapsKnownUpIsThreeNumbersAndLeavesTheEstimateAlone) {
     EXPECT_NE(e.find("c.toml:4:"), std::string::npos) << bad << ": " << e;
     EXPECT_NE(e.find("'map_up': must be a non-zero direction"), std::string::npos) << bad << ": " << e;
   }
+  const std::string side = errorOf(dir, base + "map_up = \"0, 1, 0\"\n");
+  EXPECT_NE(side.find("'map_up': leans 90.0 deg from z: a map is levelled by at most 30 deg"), std::string::npos)
+      << side << ": peers would refuse every announcement of it";
 }
 
 TEST(DaemonConfig, AWorldFrameIsOneFrameId) {
@@ -121,6 +124,8 @@ TEST(DaemonConfig, AWorldFrameIsOneFrameId) {
   const std::string e = errorOf(dir, base + "world = \"{agent}/world\"\n");
   EXPECT_NE(e.find("c.toml:5:"), std::string::npos) << e;
   EXPECT_NE(e.find("'ros2.world': must be one frame id"), std::string::npos) << e;
+  const std::string own = errorOf(dir, base + "world = \"alpha/map\"\n");
+  EXPECT_NE(own.find("'ros2.world': 'alpha/map' is alpha's map frame"), std::string::npos) << own;
 }
 
 TEST(DaemonConfig, TheRos2TableTurnsTfStaticOnWithFramesAndARootFromTheFleet) {

@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "core/gravity.hpp"
 #include "results/fleet_frame.hpp"
 
 using namespace tomomap;
@@ -162,4 +163,47 @@ TEST(FleetFrame, JsonHasThePosesPathsAndVerdicts) {
   EXPECT_EQ(j["pairs"][0]["verdict"], "consistent");
   EXPECT_TRUE(j["pairs"][0]["cycle_error"].contains("translation_m"));
   EXPECT_EQ(j["optimised_pairs"], 6);
+}
+
+TEST(FleetFrame, AMapLevelledByAnotherUpSinceAnEarlierPairIsPlacedByItsNewestUp) {
+  // Bravo's map leans 6 degrees as its SLAM saved it. Its first version was
+  // levelled by an estimate 2 degrees off (alpha<-bravo, agreed then, kept);
+  // its newest by the right up (bravo<-charlie).
+  std::mt19937 rng(5);
+  const Eigen::AngleAxisd lean(radians(6), Eigen::Vector3d(1, 2, 0).normalized());
+  const Eigen::Vector3d up = lean * Eigen::Vector3d::UnitZ();  // bravo's up in its own frame
+  const Eigen::Vector3d up_then = Eigen::AngleAxisd(radians(2), Eigen::Vector3d::UnitX()) * up;
+  Eigen::Matrix4d level_bravo = Eigen::Matrix4d::Identity();
+  level_bravo.topLeftCorner<3, 3>() = levelingOf(up).toRotationMatrix();
+  const auto levelledBy = [](const Eigen::Vector3d& u) {
+    Eigen::Matrix4d L = Eigen::Matrix4d::Identity();
+    L.topLeftCorner<3, 3>() = levelingOf(u).toRotationMatrix();
+    return L;
+  };
+  // The truth between own frames: alpha and charlie level, bravo leaning.
+  const Eigen::Matrix4d alpha_bravo = (kWorld.at("alpha").inverse() * kWorld.at("bravo")).matrix() * level_bravo;
+  const Eigen::Matrix4d bravo_charlie =
+      level_bravo.inverse() * (kWorld.at("bravo").inverse() * kWorld.at("charlie")).matrix();
+
+  AgreedTransform ab = pair("alpha", "bravo", rng), bc = pair("bravo", "charlie", rng),
+                  ac = pair("alpha", "charlie", rng);
+  ab.source_up = up_then;
+  ab.T_target_source_6dof = alpha_bravo;
+  ab.T_target_source = Pose4::fromMatrix(alpha_bravo * levelledBy(up_then).transpose());
+  ab.computed_at_ms = 1;
+  bc.target_up = up;
+  bc.T_target_source_6dof = bravo_charlie;
+  bc.computed_at_ms = 2;
+  ac.computed_at_ms = 2;
+
+  const FleetFrame frame = buildFleetFrame({ab, bc, ac}, {"alpha", "bravo", "charlie"}, "alpha", kLimits);
+  const AgentPose* bravo = frame.pose("bravo");
+  ASSERT_NE(bravo, nullptr);
+  EXPECT_TRUE(bravo->up.isApprox(up, 1e-12)) << "the newest up";
+  for (const auto& v : frame.pairs) EXPECT_EQ(v.verdict, Consistency::Consistent) << pairText(v.pair);
+  const Eigen::Matrix4d placed = frame.ownFramePose(*bravo);
+  const Eigen::Matrix3d turn = placed.topLeftCorner<3, 3>().transpose() * alpha_bravo.topLeftCorner<3, 3>();
+  EXPECT_LT(degrees(Eigen::AngleAxisd(turn).angle()), 0.2) << placed << "\nexpected\n" << alpha_bravo;
+  const Eigen::Vector4d far(8, 6, 2, 1);  // a point of bravo's map, metres from its origin
+  EXPECT_LT((placed * far - alpha_bravo * far).norm(), 0.05);
 }
