@@ -60,9 +60,7 @@ void Agent::writeStatus(bool retry_outputs) {
           {"tilt_deg", offering() && own_features_->tilt.measured ? nlohmann::json(degrees(own_features_->tilt.angle))
                                                                   : nlohmann::json()},
           {"levelled", offering() && own_features_->leveled},
-          {"up", offering() ? nlohmann::json{own_features_->slicedUp().x(), own_features_->slicedUp().y(),
-                                             own_features_->slicedUp().z()}
-                            : nlohmann::json()},
+          {"up", offering() ? upJson(own_features_->slicedUp()) : nlohmann::json()},
           {"update_refused", map_refused_},
           {"slices", a.slices().size()},
           {"payload_bytes", offer.payload_bytes},

@@ -70,7 +70,7 @@ void FleetOutputs::handTree(const Config& config) {
   Eigen::Matrix4d level = Eigen::Matrix4d::Identity();
   const AgentPose* root = frame_.pose(config.treeRoot());
   if (!world.empty() && root) {
-    level.topLeftCorner<3, 3>() = levelingOf(root->up).toRotationMatrix();
+    level = levelingMatrix(root->up);
     frames.push_back({world, config.ros2.frameOf(config.treeRoot()), level, stamp_ms});
   }
   for (const auto& e : tree)

@@ -52,13 +52,6 @@ std::vector<NamedMap> namedMaps(const std::vector<std::string>& args) {
   return maps;
 }
 
-/// The rotation that levels a map whose up is `up`, as a 4x4.
-Eigen::Matrix4d leveling(const Eigen::Vector3d& up) {
-  Eigen::Matrix4d L = Eigen::Matrix4d::Identity();
-  L.topLeftCorner<3, 3>() = levelingOf(up).toRotationMatrix();
-  return L;
-}
-
 /// The frame's poses in the reference's map levelled (z up, so that the 2D
 /// grid's heights mean something even where the reference's map leans):
 /// p_reference_levelled = T * p_agent.
@@ -66,7 +59,7 @@ std::map<std::string, Eigen::Matrix4d> levelPoses(const FleetFrame& frame) {
   std::map<std::string, Eigen::Matrix4d> poses;
   const AgentPose* reference = frame.pose(frame.reference);
   if (!reference) return poses;
-  for (const auto& p : frame.poses) poses[p.agent] = leveling(reference->up) * frame.ownFramePose(p);
+  for (const auto& p : frame.poses) poses[p.agent] = levelingMatrix(reference->up) * frame.ownFramePose(p);
   return poses;
 }
 
@@ -84,13 +77,9 @@ std::pair<std::string, std::map<std::string, Eigen::Matrix4d>> readFrameFile(con
       // Files of daemons from before maps were levelled hold the 4-DoF pose alone, and no up.
       poses[agent] = a.contains("T_reference_agent_6dof") ? matrixFromJson(a.at("T_reference_agent_6dof"))
                                                           : matrixFromJson(a.at("T_reference_agent").at("matrix"));
-      if (agent == reference && a.contains("up")) {
-        const auto up = a.at("up").get<std::array<double, 3>>();
-        reference_up = {up[0], up[1], up[2]};
-        if (!levelableUp(reference_up)) throw InputError(reference + "'s up is not a unit vector within 30 deg of z");
-      }
+      if (agent == reference && a.contains("up")) reference_up = upFromJson(a.at("up"), reference + "'s up");
     }
-    for (auto& [agent, T] : poses) T = leveling(reference_up) * T;
+    for (auto& [agent, T] : poses) T = levelingMatrix(reference_up) * T;
     return {reference, poses};
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path + ": not a frame.json: " + e.what());

@@ -291,14 +291,15 @@ Eigen::Quaterniond levelingOf(const Eigen::Vector3d& up) {
   return Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ());
 }
 
+Eigen::Matrix4d levelingMatrix(const Eigen::Vector3d& up) {
+  Eigen::Matrix4d R = Eigen::Matrix4d::Identity();
+  R.topLeftCorner<3, 3>() = levelingOf(up).toRotationMatrix();
+  return R;
+}
+
 Eigen::Matrix4d betweenOwnFrames(const Eigen::Matrix4d& T, const Eigen::Vector3d& target_up,
                                  const Eigen::Vector3d& source_up) {
-  const auto rotation = [](const Eigen::Vector3d& up) {
-    Eigen::Matrix4d R = Eigen::Matrix4d::Identity();
-    R.topLeftCorner<3, 3>() = levelingOf(up).toRotationMatrix();
-    return R;
-  };
-  return rotation(target_up).transpose() * T * rotation(source_up);
+  return levelingMatrix(target_up).transpose() * T * levelingMatrix(source_up);
 }
 
 Points rotatePoints(const Points& in, const Eigen::Quaterniond& rotation) {

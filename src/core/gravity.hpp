@@ -39,6 +39,8 @@ struct Tilt {
 /// The rotation that makes a map whose up is `up` level: it turns `up` onto z
 /// (the smallest such rotation: no yaw is added). p_levelled = R p_own.
 Eigen::Quaterniond levelingOf(const Eigen::Vector3d& up);
+/// The same as a 4x4 rigid transform (no translation).
+Eigen::Matrix4d levelingMatrix(const Eigen::Vector3d& up);
 
 /// A transform between two levelled maps (p_target_levelled = T
 /// p_source_levelled) as the transform between their own frames, from each

@@ -50,6 +50,15 @@ nlohmann::json matrixJson(const Eigen::Matrix4d& M) {
   return m;
 }
 
+nlohmann::json upJson(const Eigen::Vector3d& up) { return {up.x(), up.y(), up.z()}; }
+
+Eigen::Vector3d upFromJson(const nlohmann::json& j, const std::string& what) {
+  const auto v = j.get<std::array<double, 3>>();
+  const Eigen::Vector3d up(v[0], v[1], v[2]);
+  if (!levelableUp(up)) throw InputError(what + " is not a unit vector within 30 deg of z");
+  return up;
+}
+
 Eigen::Matrix4d matrixFromJson(const nlohmann::json& rows) {
   Eigen::Matrix4d M;
   for (int r = 0; r < 4; ++r) {
@@ -76,8 +85,8 @@ nlohmann::json toJson(const AgreedTransform& t) {
   if (t.reliable) {
     j["T_target_source"] = toJson(t.T_target_source);
     j["T_target_source_6dof"] = matrixJson(t.ownFrames());
-    j["target_up"] = {t.target_up.x(), t.target_up.y(), t.target_up.z()};
-    j["source_up"] = {t.source_up.x(), t.source_up.y(), t.source_up.z()};
+    j["target_up"] = upJson(t.target_up);
+    j["source_up"] = upJson(t.source_up);
   } else {
     j["reason"] = t.reason;
   }
@@ -105,11 +114,7 @@ AgreedTransform agreedFromJson(const nlohmann::json& j) {
                            T.at("yaw").get<double>()};
       // Files written before maps were levelled in the fleet have neither: level maps, 4-DoF.
       for (auto [key, up] : {std::pair{"target_up", &t.target_up}, std::pair{"source_up", &t.source_up}})
-        if (j.contains(key)) {
-          const auto v = j.at(key).get<std::array<double, 3>>();
-          *up = {v[0], v[1], v[2]};
-          if (!levelableUp(*up)) throw InputError(std::string(key) + " is not a unit vector within 30 deg of z");
-        }
+        if (j.contains(key)) *up = upFromJson(j.at(key), key);
       if (j.contains("T_target_source_6dof")) t.T_target_source_6dof = matrixFromJson(j.at("T_target_source_6dof"));
     } else {
       t.reason = j.value("reason", "");

@@ -261,10 +261,8 @@ FleetFrame buildFleetFrame(const std::vector<AgreedTransform>& agreed, const std
     const Eigen::Vector3d target_up = upOf(t.target), source_up = upOf(t.source);
     if (target_up == t.target_up && source_up == t.source_up) continue;
     // p_target_levelled = R_target * T_own * R_source^-1 p_source_levelled: its nearest 4-DoF.
-    Eigen::Matrix4d R_target = Eigen::Matrix4d::Identity(), R_source = Eigen::Matrix4d::Identity();
-    R_target.topLeftCorner<3, 3>() = levelingOf(target_up).toRotationMatrix();
-    R_source.topLeftCorner<3, 3>() = levelingOf(source_up).toRotationMatrix();
-    t.T_target_source = Pose4::fromMatrix(R_target * t.ownFrames() * R_source.transpose());
+    t.T_target_source =
+        Pose4::fromMatrix(levelingMatrix(target_up) * t.ownFrames() * levelingMatrix(source_up).transpose());
     t.target_up = target_up;
     t.source_up = source_up;
   }
@@ -327,7 +325,7 @@ nlohmann::json toJson(const FleetFrame& frame) {
   for (const auto& p : frame.poses)
     poses.push_back({{"agent", p.agent},
                      {"T_reference_agent", toJson(p.T_reference_agent)},
-                     {"up", {p.up.x(), p.up.y(), p.up.z()}},
+                     {"up", upJson(p.up)},
                      {"T_reference_agent_6dof", matrixJson(frame.ownFramePose(p))},
                      {"path", p.path}});
   for (const auto& v : frame.pairs) {

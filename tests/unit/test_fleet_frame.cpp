@@ -173,13 +173,7 @@ TEST(FleetFrame, AMapLevelledByAnotherUpSinceAnEarlierPairIsPlacedByItsNewestUp)
   const Eigen::AngleAxisd lean(radians(6), Eigen::Vector3d(1, 2, 0).normalized());
   const Eigen::Vector3d up = lean * Eigen::Vector3d::UnitZ();  // bravo's up in its own frame
   const Eigen::Vector3d up_then = Eigen::AngleAxisd(radians(2), Eigen::Vector3d::UnitX()) * up;
-  Eigen::Matrix4d level_bravo = Eigen::Matrix4d::Identity();
-  level_bravo.topLeftCorner<3, 3>() = levelingOf(up).toRotationMatrix();
-  const auto levelledBy = [](const Eigen::Vector3d& u) {
-    Eigen::Matrix4d L = Eigen::Matrix4d::Identity();
-    L.topLeftCorner<3, 3>() = levelingOf(u).toRotationMatrix();
-    return L;
-  };
+  const Eigen::Matrix4d level_bravo = levelingMatrix(up);
   // The truth between own frames: alpha and charlie level, bravo leaning.
   const Eigen::Matrix4d alpha_bravo = (kWorld.at("alpha").inverse() * kWorld.at("bravo")).matrix() * level_bravo;
   const Eigen::Matrix4d bravo_charlie =
@@ -189,7 +183,7 @@ TEST(FleetFrame, AMapLevelledByAnotherUpSinceAnEarlierPairIsPlacedByItsNewestUp)
                   ac = pair("alpha", "charlie", rng);
   ab.source_up = up_then;
   ab.T_target_source_6dof = alpha_bravo;
-  ab.T_target_source = Pose4::fromMatrix(alpha_bravo * levelledBy(up_then).transpose());
+  ab.T_target_source = Pose4::fromMatrix(alpha_bravo * levelingMatrix(up_then).transpose());
   ab.computed_at_ms = 1;
   bc.target_up = up;
   bc.T_target_source_6dof = bravo_charlie;
