@@ -14,6 +14,7 @@
 
 #include "clock.hpp"
 #include "config.hpp"
+#include "fleet_map_builder.hpp"
 #include "fleet_outputs.hpp"
 #include "log.hpp"
 #include "map_sender.hpp"
@@ -139,6 +140,16 @@ class Agent {
   /// Publishes `status` (status.json's content) on /diagnostics, once per
   /// kDiagnosticsPeriod at most.
   void publishDiagnostics(const nlohmann::json& status);
+  // ---- the fleet's map (agent_fleet_map.cpp)
+  /// What the fleet's map is made of now: every placed map held here.
+  FleetMapJob fleetMapJob() const;
+  /// Takes a finished build in, and starts the next when its parts changed
+  /// and the last started `[fleet_map] interval_s` ago.
+  void followFleetMap();
+  /// Builds it anew at the next chance even if nothing it is made of changed
+  /// (a new ROS 2 node, a new config).
+  void refreshFleetMap() { fleet_map_parts_.clear(); }
+
   /// One line of progress for systemd's STATUS= (and `systemctl status`).
   std::string statusLine() const;
 
@@ -146,7 +157,8 @@ class Agent {
   Log& log_;
   std::unique_ptr<transport::Bus> bus_;
   FleetOutputs outputs_{log_};  ///< the fleet's frame, transforms.json and frame.json, /tf_static
-  std::unique_ptr<transport::Ros2Node> ros2_;
+  /// Shared with a fleet-map build in progress, which publishes with it.
+  std::shared_ptr<transport::Ros2Node> ros2_;
   std::optional<Clock::time_point> diagnostics_published_;
   /// The latest map message from [ros2] map_topic not yet described; one at a
   /// time: a SLAM package may publish its map with every scan.
@@ -182,6 +194,10 @@ class Agent {
   bool reannounce_ =
       false;  ///< a peer asked for our announcement: announce again (tick, once for peers that ask together)
   Clock::time_point started_ = Clock::now();
+  FleetMapBuilder fleet_map_{[this] { queue_cv_.notify_one(); }};
+  std::vector<FleetMapPart> fleet_map_parts_;  ///< what the last build started was made of
+  std::optional<Clock::time_point> fleet_map_started_;
+  nlohmann::json fleet_map_status_;  ///< the last build's, for status.json; null before the first
 };
 
 }  // namespace tomomap::daemon

@@ -139,6 +139,7 @@ void Agent::reload() {
     }
   }
   if (ros2_changed) startRos2();
+  refreshFleetMap();
   watch_ = config_.ros2.map_topic.empty() ? std::make_unique<MapWatch>(config_.map) : nullptr;
   map_touched_ = Clock::now() - kMapSettle;  // and read the map again now
   agreedChanged();
@@ -154,6 +155,7 @@ void Agent::tick(Clock::time_point& last_announce) {
                  now);
   requestMissing();
   claimAndCompute();
+  followFleetMap();
   for (const auto& line : rejections_.due(now)) log_.warning(line);
   // Repairs a lost or missed announcement: when a peer asked for it (once
   // for peers that ask together, since each copy reaches every receiver),
@@ -239,7 +241,7 @@ int Agent::run(Signals& signals) {
     std::deque<std::function<void()>> work;
     {
       std::unique_lock<std::mutex> lock(queue_mutex_);
-      queue_cv_.wait_for(lock, kTick, [this] { return !queue_.empty() || worker_.ready(); });
+      queue_cv_.wait_for(lock, kTick, [this] { return !queue_.empty() || worker_.ready() || fleet_map_.ready(); });
       work.swap(queue_);
     }
     // A stop is not held up by a long batch (a received map's slices under

@@ -16,6 +16,7 @@ constexpr auto kDiagnosticsPeriod = std::chrono::seconds(1);
 
 void Agent::startRos2() {
   ros2_.reset();
+  refreshFleetMap();
   outputs_.setTreePublisher({});
   diagnostics_published_.reset();
   if (!config_.ros2.enabled) return;

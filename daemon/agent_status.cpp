@@ -79,7 +79,8 @@ void Agent::writeStatus(bool retry_outputs) {
         {"refused_participants", counters_.refused_participants},
         {"secure", config_.transport.security.enabled()},
         {"transforms_unwritten", outputs_.unwritten()},
-        {"write_error", outputs_.writeError()}};
+        {"write_error", outputs_.writeError()},
+        {"fleet_map", fleet_map_status_}};
     publishDiagnostics(status);
     writeJsonAtomically((dir / "status.json").string(), status);
     status_unwritten_ = false;

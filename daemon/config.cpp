@@ -171,6 +171,11 @@ void checkTogether(const Reader& r, const toml::table& root,
     }
   }
   if (c.map.empty() && c.ros2.map_topic.empty()) r.missing(root, "map");
+  if (!(c.fleet_map.band.low < c.fleet_map.band.high)) {
+    const toml::node* table = root.get("fleet_map");
+    const toml::node* at = table && table->as_table() ? table->as_table()->get("band_high") : nullptr;
+    r.fail(at ? *at : table ? *table : static_cast<const toml::node&>(root), "fleet_map.band_high", "must be above band_low");
+  }
 }
 
 }  // namespace

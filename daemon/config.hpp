@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/fleet_map.hpp"
 #include "core/matcher.hpp"
 #include "test_faults.hpp"
 #include "transport/participant.hpp"
@@ -31,6 +32,13 @@ struct Ros2Config {
   std::string frameOf(const std::string& agent) const;
 };
 
+/// The [fleet_map] table: the fleet's map built here (docs/configuration.md).
+struct FleetMapConfig {
+  bool enabled = true;
+  HeightBand band;          ///< the 2D grid's heights above the floor [m]
+  double interval_s = 10;   ///< at most one build this often [s]
+};
+
 struct Config {
   std::string file;                      ///< where it was read from
   transport::TransportConfig transport;  ///< agent id, domain, address, ports, peers, bandwidth
@@ -51,6 +59,7 @@ struct Config {
   /// Faults a test asked for (test_faults.hpp): from the environment, never the file.
   TestFaults faults;
   Ros2Config ros2;
+  FleetMapConfig fleet_map;
 
   const std::string& agent() const { return transport.agent; }
   bool isPeer(const std::string& id) const;

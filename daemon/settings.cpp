@@ -316,6 +316,24 @@ std::vector<Setting> declare() {
     s.shown = [](const Config& c) { return c.ros2.map_topic.empty() ? "(none: the map file)" : c.ros2.map_topic; };
     bindField(s, [](Config& c) { return &c.ros2.map_topic; });
   }
+  bindField(d("fleet_map.enabled", K::Flag, "", Reload::AtOnce,
+              "build the fleet's map here from the slices every agent shares (no byte more on the link): "
+              "`fleet_map.pcd`, `.pgm` + `.yaml` and `.png` beside `transforms.json`, and with `[ros2]` "
+              "`/fleet_map` and `/fleet_map_grid` (docs/operations.md, \"The fleet's map\")"),
+            [](Config& c) { return &c.fleet_map.enabled; });
+  bindField(range(d("fleet_map.band_low", K::Number, "m", Reload::AtOnce,
+                    "the 2D grid's obstacles start this high above the floor (the floor's own cells stay out)"),
+                  -10, 100),
+            [](Config& c) { return &c.fleet_map.band.low; });
+  bindField(range(d("fleet_map.band_high", K::Number, "m", Reload::AtOnce,
+                    "and end this high: the robot's body height; above `band_low`"),
+                  -10, 100),
+            [](Config& c) { return &c.fleet_map.band.high; });
+  bindField(range(d("fleet_map.interval_s", K::Number, "s", Reload::AtOnce,
+                    "build the fleet's map at most this often: again when a map or the fleet's frame changed, in "
+                    "the background (matching and sending never wait on it)"),
+                  1, 3600),
+            [](Config& c) { return &c.fleet_map.interval_s; });
   return {d.all.begin(), d.all.end()};
 }
 

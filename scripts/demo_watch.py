@@ -123,4 +123,22 @@ print(f"   matching per pair: {', '.join(f'{m:.2f}' for m in matching)} s")
 print("   bytes sent: " + ", ".join(f"{a} {sent[a] / 1e3:.0f} kB "
       f"({100 * status[a]['map']['payload_bytes'] / status[a]['map']['raw_bytes']:.1f} % of its map's binary PCD)"
       for a in agents))
+
+# The fleet's map: alpha's daemon builds it in the background from the slices
+# it holds (no byte more on the link) once all three maps are placed.
+deadline = time.time() + 120
+while True:
+    fleet_map = (load(f"{out}/alpha/status.json") or {}).get("fleet_map") or {}
+    if len(fleet_map.get("robots", [])) == 3 or time.time() > deadline:
+        break
+    time.sleep(0.2)
+print("\n== the fleet's map, built by alpha's daemon from the slices it holds (0 bytes more on the link)")
+if len(fleet_map.get("robots", [])) == 3:
+    cells = ", ".join(f"{r['agent']} {r['cells']}" for r in fleet_map["robots"])
+    print(f"   {fleet_map['cells']} cells at the grid in {fleet_map['frame']} (cells per robot: {cells})")
+    print(f"   {fleet_map['files']}: the 3D map coloured by robot (PCD), the 2D grid (map_server's PGM + YAML)")
+    print(f"   and its picture: open {out}/alpha/fleet_map.png")
+else:
+    print("   alpha has not built it with all three maps within 2 minutes: " + json.dumps(fleet_map))
+    ok = False
 sys.exit(0 if ok else 1)

@@ -14,10 +14,8 @@
 #include "core/voxel_filter.hpp"
 #include "grid_option.hpp"
 #include "io/map_io.hpp"
-#include "io/map_server_files.hpp"
 #include "results/fleet_frame.hpp"
-#include "viz/canvas.hpp"
-#include "viz/fleet_map_picture.hpp"
+#include "viz/fleet_map_files.hpp"
 
 namespace tomomap::cli {
 namespace {
@@ -29,7 +27,7 @@ struct MergeOptions {
   std::string out = "fleet-map";
   std::string frame;  // a daemon's frame.json; empty: match here
   MatchParams params;
-  std::vector<double> band{0.2, 1.5};  // above the floor [m]
+  std::vector<double> band{HeightBand{}.low, HeightBand{}.high};
 };
 
 struct NamedMap {
@@ -167,25 +165,15 @@ int runMerge(const MergeOptions& o) {
   if (placed.empty()) throw InputError("none of the maps is placed in " + reference + "'s frame");
 
   const FleetMap merged = mergeMaps(placed, o.params.grid);
-  const double floor = floorHeight(merged);
-  const double z_low = floor + o.band[0], z_high = floor + o.band[1];
-  const OccupancyGrid2D grid = occupancyGrid(merged, z_low, z_high);
-
-  const std::string stem = (fs::path(o.out) / "fleet_map").string();
-  std::vector<uint32_t> colours;
-  for (size_t r = 0; r < merged.agents.size(); ++r) colours.push_back(viz::robotRgb(r));
-  saveLabelledPcd(stem + ".pcd", merged.points, merged.robot, colours);
-  saveMapServerMap(stem, grid);
+  const HeightBand band{o.band[0], o.band[1]};
+  const FleetGrid fleet_grid = fleetGrid(merged, band);
+  const OccupancyGrid2D& grid = fleet_grid.grid;
+  const double floor = fleet_grid.floor;
+  const std::string stem = viz::writeFleetMapFiles(
+      o.out, merged, fleet_grid, viz::fleetMapCaption(merged, fleet_grid, band, reference + "'s frame, levelled"));
   std::string counts;
   for (size_t r = 0; r < merged.agents.size(); ++r)
     counts += (r ? ", " : "") + merged.agents[r] + " " + std::to_string(merged.cells_of[r]);
-  const std::vector<std::string> caption{
-      "The fleet's map in " + reference + "'s frame, levelled: " + std::to_string(merged.agents.size()) + " robots, " +
-          std::to_string(merged.points.size()) + " cells at g " + fixed(o.params.grid, 2) + " m",
-      "in colour: what each robot's map holds " + fixed(o.band[0], 2) + "-" + fixed(o.band[1], 2) +
-          " m above the floor (z " + fixed(floor, 2) + " m); grey: the rest"};
-  viz::writePng(stem + ".png", viz::drawFleetMap(merged, z_low, z_high, caption));
-
   std::cout << "fleet map        " << stem << ".pcd: " << merged.points.size() << " cells at g " << o.params.grid
             << " m in " << reference << "'s frame, levelled (cells per robot: " << counts
             << "; fields x y z rgba label, label = the robot's place in this list)\n"

@@ -8,6 +8,22 @@
 #include "lattice.hpp"
 
 namespace tomomap {
+
+Points occupiedCells(const SliceStack& stack) {
+  Points out;
+  size_t total = 0;
+  for (const auto& slice : stack.cells) total += slice.size();
+  out.reserve(total);
+  for (int k = 0; k < stack.size(); ++k) {
+    const auto z = static_cast<float>(stack.grid.sliceHeight(k));
+    for (const uint32_t cell : stack.cells[static_cast<size_t>(k)]) {
+      const Eigen::Vector2d xy = stack.grid.cellCentre(cell);
+      out.emplace_back(static_cast<float>(xy.x()), static_cast<float>(xy.y()), z);
+    }
+  }
+  return out;
+}
+
 FleetMap mergeMaps(const std::vector<PlacedMap>& maps, double grid) {
   if (!(grid > 0)) throw InputError("the fleet map's grid must be positive");
   FleetMap out;
@@ -75,6 +91,15 @@ OccupancyGrid2D occupancyGrid(const FleetMap& map, double z_low, double z_high) 
     g.cells[static_cast<size_t>(row) * static_cast<size_t>(g.width) + static_cast<size_t>(column)] =
         OccupancyGrid2D::kOccupied;
   }
+  return g;
+}
+
+FleetGrid fleetGrid(const FleetMap& map, const HeightBand& band) {
+  FleetGrid g;
+  g.floor = floorHeight(map);
+  g.z_low = g.floor + band.low;
+  g.z_high = g.floor + band.high;
+  g.grid = occupancyGrid(map, g.z_low, g.z_high);
   return g;
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "slices.hpp"
 #include "types.hpp"
 
 namespace tomomap {
@@ -28,6 +29,11 @@ struct FleetMap {
   std::vector<size_t> cells_of;  ///< per robot: the cells its map occupies in the root frame (shared ones included)
 };
 
+/// The occupied cells of a stack of slices: each cell's centre in the frame
+/// the map was sliced in (levelled where it was), at its slice's height.
+/// Slices without cells (too sparse to describe, or received as features) add none.
+Points occupiedCells(const SliceStack& stack);
+
 /// Places every map by its transform and merges them on the root frame's
 /// lattice of `grid` (cells with a corner at the origin): each occupied cell
 /// once. Throws InputError where they span more than 2^20 cells along an axis.
@@ -39,6 +45,13 @@ FleetMap mergeMaps(const std::vector<PlacedMap>& maps, double grid);
 /// lowest of them is the ground floor (a few returns below it, a cell layer
 /// of a staircase, do not count). NaN for an empty map.
 double floorHeight(const FleetMap& map);
+
+/// The heights a 2D grid sees, above the floor [m]: what a ground robot's
+/// body meets. The default clears the floor's own cells and a low kerb and
+/// reaches a person's shoulder: a wheeled robot's sensors and arm.
+struct HeightBand {
+  double low = 0.2, high = 1.5;
+};
 
 /// A 2D occupancy grid in ROS's nav_msgs/OccupancyGrid convention: row 0 at
 /// `y_min`, column 0 at `x_min`, values 100 occupied, 0 free, -1 unknown.
@@ -58,5 +71,14 @@ constexpr double kMaxGridCells = 1e8;
 /// above: occupied where one is, unknown elsewhere (the slices carry where a
 /// map is occupied, not where a robot saw free space). Covers every cell of the map.
 OccupancyGrid2D occupancyGrid(const FleetMap& map, double z_low, double z_high);
+
+/// The fleet map's 2D view: its floor, the band's heights above it, and the grid of them.
+struct FleetGrid {
+  double floor = 0;                 ///< floorHeight [m]
+  double z_low = 0, z_high = 0;     ///< the band above the floor [m]
+  OccupancyGrid2D grid;
+};
+/// The same for `band`; throws InputError like occupancyGrid.
+FleetGrid fleetGrid(const FleetMap& map, const HeightBand& band);
 
 }  // namespace tomomap

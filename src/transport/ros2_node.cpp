@@ -14,6 +14,8 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
+#include <cmath>
+#include <cstring>
 #include <mutex>
 #include <stdexcept>
 
@@ -26,10 +28,13 @@ namespace ros_tf = tf2_msgs::msg::dds_;
 namespace ros_geometry = geometry_msgs::msg::dds_;
 namespace ros_diagnostic = diagnostic_msgs::msg::dds_;
 namespace ros_sensor = sensor_msgs::msg::dds_;
+namespace ros_nav = nav_msgs::msg::dds_;
 
 /// ROS 2's names: topic "rt/" + the ROS topic name.
 constexpr const char* kTfStaticTopic = "rt/tf_static";
 constexpr const char* kDiagnosticsTopic = "rt/diagnostics";
+constexpr const char* kFleetMapTopic = "rt/fleet_map";
+constexpr const char* kFleetGridTopic = "rt/fleet_map_grid";
 
 /// builtin_interfaces/Time for `ms` [ms since the epoch].
 builtin_interfaces::msg::dds_::Time_ rosTime(uint64_t ms) {
@@ -51,6 +56,21 @@ EndpointQos reliableKeepLast1(EndpointQos q, DurabilityQosPolicyKind durability)
   q.endpoint().history_memory_policy = eprosima::fastrtps::rtps::DYNAMIC_REUSABLE_MEMORY_MODE;
   return q;
 }
+
+/// geometry_msgs/Quaternion of a rotation, w >= 0 (of the two, the turn of at most half a circle).
+ros_geometry::Quaternion_ rosQuaternion(const Eigen::Matrix3d& R) {
+  Eigen::Quaterniond r(R);
+  if (r.w() < 0) r.coeffs() *= -1.0;
+  ros_geometry::Quaternion_ q;
+  q.x(r.x());
+  q.y(r.y());
+  q.z(r.z());
+  q.w(r.w());
+  return q;
+}
+
+/// sensor_msgs/PointField's FLOAT32 and UINT32 (sensor_msgs/msg/PointField.msg).
+constexpr uint8_t kFloat32 = 7, kUint32 = 6;
 
 /// Takes the map messages of both readers of the map topic (transient local
 /// and volatile: each matches writers the other cannot) and hands each on once.
@@ -98,6 +118,8 @@ struct Ros2Node::Impl {
   Publisher* publisher = nullptr;
   DataWriter* tf_static = nullptr;
   DataWriter* diagnostics = nullptr;
+  DataWriter* fleet_map = nullptr;
+  DataWriter* fleet_grid = nullptr;
   std::unique_ptr<MapListener> map_listener;
 
   /// `topic` with its `type` registered.
@@ -186,6 +208,13 @@ Ros2Node::Ros2Node(int ros_domain, bool localhost_only) : impl_(std::make_unique
   // diagnostic_updater's: volatile (a late reader waits for the next).
   i.diagnostics = i.writer(TypeSupport(new ros_diagnostic::DiagnosticArray_PubSubType()), kDiagnosticsTopic,
                            reliableKeepLast1(DATAWRITER_QOS_DEFAULT, VOLATILE_DURABILITY_QOS));
+  // Map servers' QoS: transient local, so RViz started later gets the map.
+  // Asynchronous: a map of megabytes leaves in fragments on Fast DDS's own
+  // thread, not on the caller's.
+  DataWriterQos latched = reliableKeepLast1(DATAWRITER_QOS_DEFAULT, TRANSIENT_LOCAL_DURABILITY_QOS);
+  latched.publish_mode().kind = ASYNCHRONOUS_PUBLISH_MODE;
+  i.fleet_map = i.writer(TypeSupport(new ros_sensor::PointCloud2_PubSubType()), kFleetMapTopic, latched);
+  i.fleet_grid = i.writer(TypeSupport(new ros_nav::OccupancyGrid_PubSubType()), kFleetGridTopic, latched);
 }
 
 Ros2Node::~Ros2Node() = default;
@@ -200,12 +229,7 @@ void Ros2Node::publishTfStatic(const std::vector<TfFrame>& frames) {
     t.transform().translation().x(f.T_parent_child(0, 3));
     t.transform().translation().y(f.T_parent_child(1, 3));
     t.transform().translation().z(f.T_parent_child(2, 3));
-    Eigen::Quaterniond r(Eigen::Matrix3d(f.T_parent_child.topLeftCorner<3, 3>()));
-    if (r.w() < 0) r.coeffs() *= -1.0;  // one of the two: w >= 0, a turn of at most half a circle
-    t.transform().rotation().x(r.x());
-    t.transform().rotation().y(r.y());
-    t.transform().rotation().z(r.z());
-    t.transform().rotation().w(r.w());
+    t.transform().rotation(rosQuaternion(f.T_parent_child.topLeftCorner<3, 3>()));
     msg.transforms().push_back(std::move(t));
   }
   impl_->tf_static->write(&msg);
@@ -229,6 +253,64 @@ void Ros2Node::publishDiagnostics(const std::vector<Diagnostic>& statuses, uint6
     msg.status().push_back(std::move(s));
   }
   impl_->diagnostics->write(&msg);
+}
+
+void Ros2Node::publishFleetMap(const FleetMapMessage& m) {
+  const FleetMap& map = *m.map;
+  const Eigen::Matrix3f R = m.T_frame_map.topLeftCorner<3, 3>().cast<float>();
+  const Eigen::Vector3f t = m.T_frame_map.topRightCorner<3, 1>().cast<float>();
+
+  ros_sensor::PointCloud2_ cloud;
+  cloud.header().stamp(rosTime(m.stamp_ms));
+  cloud.header().frame_id(m.frame_id);
+  // PCL's PointXYZRGBL as pcl_conversions lays it out: RViz colours by rgb.
+  uint32_t offset = 0;
+  for (const char* name : {"x", "y", "z", "rgb", "label"}) {
+    ros_sensor::PointField_ f;
+    f.name(name);
+    f.offset(offset);
+    f.datatype(std::string(name) == "label" ? kUint32 : kFloat32);
+    f.count(1);
+    cloud.fields().push_back(std::move(f));
+    offset += 4;
+  }
+  constexpr uint32_t kStep = 20;
+  cloud.height(1);
+  cloud.width(static_cast<uint32_t>(map.points.size()));
+  cloud.is_bigendian(false);
+  cloud.point_step(kStep);
+  cloud.row_step(kStep * cloud.width());
+  cloud.is_dense(true);
+  std::vector<uint8_t>& data = cloud.data();
+  data.resize(static_cast<size_t>(kStep) * map.points.size());
+  for (size_t i = 0; i < map.points.size(); ++i) {
+    const Eigen::Vector3f p = R * map.points[i] + t;
+    const uint32_t label = map.robot[i], rgb = m.colours.at(label);
+    uint8_t* out = data.data() + i * kStep;
+    std::memcpy(out, p.data(), 12);  // little-endian hosts: is_bigendian false
+    std::memcpy(out + 12, &rgb, 4);
+    std::memcpy(out + 16, &label, 4);
+  }
+  impl_->fleet_map->write(&cloud);
+
+  const OccupancyGrid2D& g = m.grid->grid;
+  ros_nav::OccupancyGrid_ grid;
+  grid.header().stamp(rosTime(m.stamp_ms));
+  grid.header().frame_id(m.frame_id);
+  grid.info().map_load_time(rosTime(m.stamp_ms));
+  grid.info().resolution(static_cast<float>(g.resolution));
+  grid.info().width(static_cast<uint32_t>(g.width));
+  grid.info().height(static_cast<uint32_t>(g.height));
+  // The grid lies at the floor's height, turned with the map into the frame.
+  const Eigen::Vector3d corner =
+      m.T_frame_map.topLeftCorner<3, 3>() * Eigen::Vector3d(g.x_min, g.y_min, std::isfinite(m.grid->floor) ? m.grid->floor : 0) +
+      m.T_frame_map.topRightCorner<3, 1>();
+  grid.info().origin().position().x(corner.x());
+  grid.info().origin().position().y(corner.y());
+  grid.info().origin().position().z(corner.z());
+  grid.info().origin().orientation(rosQuaternion(m.T_frame_map.topLeftCorner<3, 3>()));
+  grid.data().assign(g.cells.begin(), g.cells.end());
+  impl_->fleet_grid->write(&grid);
 }
 
 void Ros2Node::subscribeMap(const std::string& topic, std::function<void(CloudMessage&&)> on_message) {

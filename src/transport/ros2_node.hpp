@@ -4,15 +4,17 @@
 // broadcaster does (rt/tf_static, tf2_msgs::msg::dds_::TFMessage_, reliable,
 // transient local, the whole tree in the last sample), and the daemon's health
 // on /diagnostics as diagnostic_updater publishes it (rt/diagnostics,
-// diagnostic_msgs::msg::dds_::DiagnosticArray_, reliable, volatile). ROS 2
-// nodes see both with no ROS 2 dependency here (docs/operations.md, "ROS 2").
+// diagnostic_msgs::msg::dds_::DiagnosticArray_, reliable, volatile), and the
+// fleet's map as map servers publish theirs (/fleet_map, sensor_msgs/PointCloud2,
+// and /fleet_map_grid, nav_msgs/OccupancyGrid: reliable, transient local). ROS 2
+// nodes see them with no ROS 2 dependency here (docs/operations.md, "ROS 2").
 #include <functional>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "core/types.hpp"
+#include "core/fleet_map.hpp"
 #include "io/point_cloud2.hpp"
 
 namespace tomomap::transport {
@@ -39,6 +41,18 @@ struct CloudMessage {
   std::string frame_id;
 };
 
+/// The fleet's map as ROS 2 gets it: the merged cells and their 2D grid,
+/// placed in the frame `frame_id` by `T_frame_map` (the map's frame is the
+/// root's map levelled, z up).
+struct FleetMapMessage {
+  const FleetMap* map = nullptr;
+  const FleetGrid* grid = nullptr;
+  std::vector<uint32_t> colours;  ///< per robot of `map`: 0xRRGGBB
+  std::string frame_id;
+  Eigen::Matrix4d T_frame_map = Eigen::Matrix4d::Identity();
+  uint64_t stamp_ms = 0;  ///< [ms since the epoch]
+};
+
 class Ros2Node {
  public:
   /// `localhost_only`: the participant reaches ROS 2 nodes on this host only,
@@ -54,6 +68,10 @@ class Ros2Node {
   void publishTfStatic(const std::vector<TfFrame>& frames);
   /// One DiagnosticArray on /diagnostics, stamped `stamp_ms` [ms since the epoch].
   void publishDiagnostics(const std::vector<Diagnostic>& statuses, uint64_t stamp_ms);
+  /// Replaces the fleet's map: /fleet_map (PointCloud2: x, y, z, rgb as
+  /// float32, label as uint32, a point per cell) and /fleet_map_grid
+  /// (OccupancyGrid), both latched (transient local, keep last 1).
+  void publishFleetMap(const FleetMapMessage& m);
   /// Reads sensor_msgs/PointCloud2 from the ROS 2 topic `topic` (e.g.
   /// /Laser_map) with the QoS SLAM packages publish maps with: reliable, keep
   /// last 1, volatile or transient local (a latched map that was published

@@ -3,14 +3,9 @@
 
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <unordered_set>
 
-#include "core/fleet_map.hpp"
-#include "core/lattice.hpp"
-#include "core/voxel_filter.hpp"
-#include "io/map_io.hpp"
+#include "fleet_map_truth.hpp"
 #include "results/agreed_transform.hpp"
-#include "support.hpp"
 
 using namespace tomomap;
 using namespace tomomap::test;
@@ -19,32 +14,11 @@ namespace {
 
 constexpr double kGrid = 0.1;
 
-/// Map i's pose in map 0's frame, from the generator's poses (world to map: P_0 P_i^-1).
-Eigen::Matrix4d truthOf(const TempDir& dir, int i) {
-  return loadPoseFile(dir / "w/map_0-gtpose.txt") *
-         loadPoseFile(dir / ("w/map_" + std::to_string(i) + "-gtpose.txt")).inverse();
-}
+/// Map i's pose in map 0's frame.
+Eigen::Matrix4d truthOf(const TempDir& dir, int i) { return test::truthOf(dir / "w", i); }
 
-/// The share of `merged`'s cells within one cell (a neighbour on the
-/// lattice) of a cell of the maps merged by their true poses.
 double shareNearTheTruth(const TempDir& dir, const Points& merged, int maps) {
-  std::vector<PlacedMap> truth;
-  for (int i = 0; i < maps; ++i)
-    truth.push_back({"m" + std::to_string(i),
-                     voxelFilter(loadMap(dir / ("w/map_" + std::to_string(i) + ".pcd")), kGrid), truthOf(dir, i)});
-  std::unordered_set<uint64_t> cells;
-  for (const auto& p : mergeMaps(truth, kGrid).points) cells.insert(latticeKey(p, kGrid));
-  size_t near = 0;
-  for (const auto& p : merged) {
-    bool found = false;
-    for (int dx = -1; dx <= 1 && !found; ++dx)
-      for (int dy = -1; dy <= 1 && !found; ++dy)
-        for (int dz = -1; dz <= 1 && !found; ++dz)
-          found = cells.count(
-                      latticeKey(p + Eigen::Vector3i(dx, dy, dz).cast<float>() * static_cast<float>(kGrid), kGrid)) > 0;
-    near += found;
-  }
-  return merged.empty() ? 0.0 : static_cast<double>(near) / static_cast<double>(merged.size());
+  return test::shareNearTheTruth(dir / "w", merged, maps, kGrid);
 }
 
 void synthThree(const TempDir& dir) {

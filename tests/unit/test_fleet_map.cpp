@@ -2,6 +2,8 @@
 // lattice, the floor found, the 2D grid of a height band.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "core/fleet_map.hpp"
 
 using namespace tomomap;
@@ -60,4 +62,34 @@ TEST(FleetMap, TheFloorIsTheFullestLowLayerAndTheGridHoldsTheBandsCells) {
   EXPECT_EQ(g.at(20, 15), OccupancyGrid2D::kUnknown) << "the floor is no obstacle";
   EXPECT_TRUE(std::isnan(floorHeight(FleetMap{})));
   EXPECT_EQ(occupancyGrid(FleetMap{}, 0, 1).cells.size(), 0u);
+}
+
+TEST(FleetMap, ASliceStacksCellsLieWhereItsPointsAreAtTheirSlicesHeights) {
+  // The room sliced as a daemon slices a map (off the lattice's edges by a
+  // quarter cell): the cells it holds of it are where the room's points are.
+  Points points = room();
+  for (auto& p : points) p.head<2>().array() += 0.025f;
+  const SliceStack stack = makeSlices(points, kGrid, 1);
+  const Points cells = occupiedCells(stack);
+  size_t held = 0;
+  for (const auto& slice : stack.cells) held += slice.size();
+  ASSERT_EQ(cells.size(), held);
+  ASSERT_GT(held, 1000u);
+  for (const auto& c : cells) {
+    const bool near = std::any_of(points.begin(), points.end(), [&](const Eigen::Vector3f& p) {
+      return (p - c).cwiseAbs().maxCoeff() <= 0.5f * static_cast<float>(kGrid) + 1e-4f;
+    });
+    ASSERT_TRUE(near) << c.transpose();
+  }
+  // Merged alone, it is the room: its floor where the room's is, the walls in the band.
+  const FleetMap map = mergeMaps({{"alpha", cells, Eigen::Matrix4d::Identity()}}, kGrid);
+  const FleetGrid grid = fleetGrid(map, HeightBand{});
+  EXPECT_NEAR(grid.floor, -0.95, 0.5 * kGrid);
+  EXPECT_NEAR(grid.z_high - grid.z_low, HeightBand{}.high - HeightBand{}.low, 1e-9);
+  size_t occupied = 0;
+  for (const int8_t v : grid.grid.cells) occupied += v == OccupancyGrid2D::kOccupied;
+  // The two walls seen from above (69 columns, less the ends slicing left out as
+  // stray returns), and nothing of the floor's 1,200.
+  EXPECT_LE(occupied, 40u + 30u - 1u);
+  EXPECT_GE(occupied, 55u);
 }

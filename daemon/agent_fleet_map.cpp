@@ -1,0 +1,63 @@
+// The fleet's map as the agent keeps it (fleet_map_builder.hpp): which maps
+// it is made of now, and when to build it again.
+#include "agent.hpp"
+#include "core/gravity.hpp"
+#include "viz/fleet_map_picture.hpp"
+
+namespace tomomap::daemon {
+
+FleetMapJob Agent::fleetMapJob() const {
+  FleetMapJob job;
+  const std::string root = config_.treeRoot();
+  const FleetFrame& frame = outputs_.frame();
+  const AgentPose* root_pose = frame.pose(root);
+  if (!root_pose) return job;  // the root is not placed: there is no frame to build in
+  if (auto m = featuresOf(root)) job.parts.push_back({root, std::move(m), Pose4{}});
+  for (const auto& edge : treeOf(frame, root, 0))
+    if (auto m = featuresOf(edge.child)) job.parts.push_back({edge.child, std::move(m), edge.T_parent_child});
+  job.grid = config_.match.grid;
+  job.band = config_.fleet_map.band;
+  job.dir = config_.output_dir;
+  job.where = root + "'s frame, levelled";
+  if (ros2_) {
+    // Under a world frame the map is where the world is (the root's map
+    // levelled); else in the root's map frame, the levelling undone.
+    const bool world = !config_.ros2.world.empty();
+    const std::string frame_id = world ? config_.ros2.world : config_.ros2.frameOf(root);
+    const Eigen::Matrix4d T_frame_map =
+        world ? Eigen::Matrix4d::Identity() : Eigen::Matrix4d(levelingMatrix(root_pose->up).inverse());
+    job.publish = [node = ros2_, frame_id, T_frame_map](const FleetMap& map, const FleetGrid& grid) {
+      transport::FleetMapMessage m{&map, &grid, {}, frame_id, T_frame_map, wallMs()};
+      for (size_t r = 0; r < map.agents.size(); ++r) m.colours.push_back(viz::robotRgb(r));
+      node->publishFleetMap(m);
+    };
+  }
+  return job;
+}
+
+void Agent::followFleetMap() {
+  if (fleet_map_.ready()) {
+    fleet_map_status_ = fleet_map_.take();
+    if (fleet_map_status_.contains("error")) {
+      log_.warning("cannot build the fleet's map (trying again at the next change): " +
+                   fleet_map_status_["error"].get<std::string>());
+    } else {
+      std::string robots;
+      for (const auto& r : fleet_map_status_["robots"])
+        robots += (robots.empty() ? "" : ", ") + r["agent"].get<std::string>() + " " + std::to_string(r["cells"].get<size_t>());
+      log_.info("fleet map: " + std::to_string(fleet_map_status_["cells"].get<size_t>()) + " cells (" + robots +
+                ") in " + fleet_map_status_["frame"].get<std::string>() + ": " +
+                fleet_map_status_["files"].get<std::string>() + (ros2_ ? ", /fleet_map and /fleet_map_grid" : ""));
+    }
+  }
+  if (!config_.fleet_map.enabled || !fleet_map_.idle()) return;
+  const auto now = Clock::now();
+  if (fleet_map_started_ && now - *fleet_map_started_ < fromSeconds(config_.fleet_map.interval_s)) return;
+  FleetMapJob job = fleetMapJob();
+  if (job.parts.empty() || job.parts == fleet_map_parts_) return;
+  fleet_map_parts_ = job.parts;
+  fleet_map_started_ = now;
+  fleet_map_.start(std::move(job));
+}
+
+}  // namespace tomomap::daemon
