@@ -3,6 +3,7 @@
 #include "core/map_check.hpp"
 #include "core/text.hpp"
 #include "io/map_io.hpp"
+#include "io/octomap_io.hpp"
 #include "io/point_cloud2.hpp"
 #include "transport/estimate_wire.hpp"
 
@@ -83,15 +84,18 @@ Described Agent::described() const {
   return {own_features_, std::make_shared<const transport::MapOffer>(sender_.offer())};
 }
 
-OwnMap describeOwnMap(const Config& config, const transport::CloudMessage& cloud, const Described& before) {
+OwnMap describeOwnMap(const Config& config, const transport::MapMessage& message, const Described& before) {
   OwnMap own;
-  own.frame_id = cloud.frame_id;
+  own.frame_id = message.frame_id;
   return describeLoaded(
       config, std::move(own),
       [&](OwnMap& o) {
         Points points;
         try {
-          points = pointsFromCloud2(cloud.layout, cloud.data.data(), cloud.data.size(), &o.nonfinite);
+          if (const auto& tree = message.octomap)
+            points = octomapFromMessage(tree->binary, tree->id, tree->resolution, message.data);
+          else
+            points = pointsFromCloud2(message.layout, message.data.data(), message.data.size(), &o.nonfinite);
         } catch (const InputError& e) {
           throw InputError(mapSource(config) + ": " + e.what());
         }

@@ -63,7 +63,7 @@ struct Described {
 /// InputError for an unreadable map. Pure work: safe to run on any thread.
 OwnMap describeOwnMap(const Config& config, const Described& before = {});
 /// The same for a map that arrived on the [ros2] map_topic.
-OwnMap describeOwnMap(const Config& config, const transport::CloudMessage& cloud, const Described& before = {});
+OwnMap describeOwnMap(const Config& config, const transport::MapMessage& message, const Described& before = {});
 
 /// The claim timings the config sets.
 inline BoardTimings boardTimings(const Config& c) {
@@ -162,7 +162,7 @@ class Agent {
   std::optional<Clock::time_point> diagnostics_published_;
   /// The latest map message from [ros2] map_topic not yet described; one at a
   /// time: a SLAM package may publish its map with every scan.
-  std::shared_ptr<const transport::CloudMessage> cloud_;
+  std::shared_ptr<const transport::MapMessage> cloud_;
   std::string map_frame_id_;  ///< the frame of the map offered, when it came from a topic
   transport::BusHandlers handlers_;
   Notifier notifier_;

@@ -27,13 +27,14 @@ void Agent::startRos2() {
       // package may publish one with every scan: the newest is described once
       // the last description is done and the first message waiting for it
       // has waited kMapSettle (agent_lifecycle.cpp).
-      ros2_->subscribeMap(config_.ros2.map_topic, [this](transport::CloudMessage&& m) {
-        post([this, m = std::make_shared<const transport::CloudMessage>(std::move(m))] {
+      ros2_->subscribeMap(config_.ros2.map_topic, config_.ros2.map_type, [this](transport::MapMessage&& m) {
+        post([this, m = std::make_shared<const transport::MapMessage>(std::move(m))] {
           cloud_ = m;
           if (!map_touched_) map_touched_ = Clock::now();
         });
       });
-      log_.info("ROS 2: reading this robot's map from " + config_.ros2.map_topic + " (sensor_msgs/PointCloud2)");
+      log_.info("ROS 2: reading this robot's map from " + config_.ros2.map_topic + " (" +
+                mapTypeName(config_.ros2.map_type) + ")");
     }
     outputs_.setTreePublisher([node = ros2_.get()](const auto& frames) { node->publishTfStatic(frames); });
     log_.info("ROS 2: publishing the fleet's frames on /tf_static and this daemon's health on /diagnostics (domain " +

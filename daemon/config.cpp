@@ -201,6 +201,10 @@ std::string Config::frameReference() const {
 
 std::string Config::treeRoot() const { return ros2.root.empty() ? frameReference() : ros2.root; }
 
+const char* mapTypeName(transport::MapMessageType type) {
+  return type == transport::MapMessageType::Octomap ? "octomap_msgs/Octomap" : "sensor_msgs/PointCloud2";
+}
+
 std::string Ros2Config::frameOf(const std::string& agent) const {
   std::string f = frame;
   for (size_t at = f.find("{agent}"); at != std::string::npos; at = f.find("{agent}", at + agent.size()))

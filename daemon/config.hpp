@@ -9,6 +9,7 @@
 #include "core/matcher.hpp"
 #include "test_faults.hpp"
 #include "transport/participant.hpp"
+#include "transport/ros2_node.hpp"
 
 namespace tomomap::daemon {
 
@@ -28,9 +29,13 @@ struct Ros2Config {
   /// A sensor_msgs/PointCloud2 topic that carries this robot's map (its SLAM's
   /// map cloud), instead of the `map` file; empty: the file.
   std::string map_topic;
+  transport::MapMessageType map_type = transport::MapMessageType::PointCloud2;  ///< what map_topic carries
 
   std::string frameOf(const std::string& agent) const;
 };
+
+/// A map message type's ROS name ("sensor_msgs/PointCloud2", "octomap_msgs/Octomap").
+const char* mapTypeName(transport::MapMessageType type);
 
 /// The [fleet_map] table: the fleet's map built here (docs/configuration.md).
 struct FleetMapConfig {

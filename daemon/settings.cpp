@@ -305,8 +305,9 @@ std::vector<Setting> declare() {
             [](Config& c) { return &c.ros2.localhost_only; });
   {
     Setting& s = d("ros2.map_topic", K::Text, "ROS 2 topic name", Reload::RestartsRos2,
-                   "read the robot's map from this `sensor_msgs/PointCloud2` topic (its SLAM's map cloud, e.g. "
-                   "`/Laser_map`) instead of the `map` file, which must then be absent: x, y, z as float32 or "
+                   "read the robot's map from this topic (of `map_type`; its SLAM's map cloud, e.g. `/Laser_map`, or "
+                   "octomap_server's `/octomap_binary`) instead of the `map` file, which must then be absent; a "
+                   "`sensor_msgs/PointCloud2`'s x, y, z as float32 or "
                    "float64 in any field layout, organised or not (holes dropped and counted); big-endian clouds "
                    "are refused with a log line; reliable, volatile or transient local; each new message is a map "
                    "update, described once the previous one is done and the first waiting message is 1 s old (the "
@@ -315,6 +316,23 @@ std::vector<Setting> declare() {
     s.default_text = "none";
     s.shown = [](const Config& c) { return c.ros2.map_topic.empty() ? "(none: the map file)" : c.ros2.map_topic; };
     bindField(s, [](Config& c) { return &c.ros2.map_topic; });
+  }
+  {
+    Setting& s = d("ros2.map_type", K::Text, "", Reload::RestartsRos2,
+                   "what `map_topic` carries: `sensor_msgs/PointCloud2`, or `octomap_msgs/Octomap` (octomap_server's "
+                   "`/octomap_binary` or `/octomap_full`: binary or full trees of type `OcTree`, read by octomap's "
+                   "own deserialiser; the map is the centres of the occupied voxels at the tree's resolution)");
+    s.check = [](const V& v) -> Check {
+      for (const auto type : {transport::MapMessageType::PointCloud2, transport::MapMessageType::Octomap})
+        if (text(v) == mapTypeName(type)) return std::nullopt;
+      return "must be sensor_msgs/PointCloud2 or octomap_msgs/Octomap";
+    };
+    s.get = [](const Config& c) -> V { return std::string(mapTypeName(c.ros2.map_type)); };
+    s.set = [](Config& c, const V& v) {
+      c.ros2.map_type = text(v) == mapTypeName(transport::MapMessageType::Octomap)
+                            ? transport::MapMessageType::Octomap
+                            : transport::MapMessageType::PointCloud2;
+    };
   }
   bindField(d("fleet_map.enabled", K::Flag, "", Reload::AtOnce,
               "build the fleet's map here from the slices every agent shares (no byte more on the link): "

@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "ros2_msgsPubSubTypes.h"
+#include "ros2_type_hash.hpp"
 
 namespace tomomap::transport {
 
@@ -29,6 +30,7 @@ namespace ros_geometry = geometry_msgs::msg::dds_;
 namespace ros_diagnostic = diagnostic_msgs::msg::dds_;
 namespace ros_sensor = sensor_msgs::msg::dds_;
 namespace ros_nav = nav_msgs::msg::dds_;
+namespace ros_octomap = octomap_msgs::msg::dds_;
 
 /// ROS 2's names: topic "rt/" + the ROS topic name.
 constexpr const char* kTfStaticTopic = "rt/tf_static";
@@ -72,27 +74,42 @@ ros_geometry::Quaternion_ rosQuaternion(const Eigen::Matrix3d& R) {
 /// sensor_msgs/PointField's FLOAT32 and UINT32 (sensor_msgs/msg/PointField.msg).
 constexpr uint8_t kFloat32 = 7, kUint32 = 6;
 
-/// Takes the map messages of both readers of the map topic (transient local
-/// and volatile: each matches writers the other cannot) and hands each on once.
+/// A map message as it arrived, undecoded.
+MapMessage mapMessageOf(ros_sensor::PointCloud2_& msg) {
+  MapMessage m;
+  m.layout.height = msg.height();
+  m.layout.width = msg.width();
+  m.layout.is_bigendian = msg.is_bigendian();
+  m.layout.point_step = msg.point_step();
+  m.layout.row_step = msg.row_step();
+  for (const auto& f : msg.fields()) m.layout.fields.push_back({f.name(), f.offset(), f.datatype(), f.count()});
+  m.data = std::move(msg.data());
+  m.frame_id = msg.header().frame_id();
+  return m;
+}
+
+MapMessage mapMessageOf(ros_octomap::Octomap_& msg) {
+  MapMessage m;
+  m.octomap = OctomapTree{msg.binary(), msg.id(), msg.resolution()};
+  m.data.assign(msg.data().begin(), msg.data().end());
+  m.frame_id = msg.header().frame_id();
+  return m;
+}
+
+/// Takes the map messages (of ROS type `Msg`) of both readers of the map
+/// topic (transient local and volatile: each matches writers the other
+/// cannot) and hands each on once.
+template <class Msg>
 class MapListener : public DataReaderListener {
  public:
-  explicit MapListener(std::function<void(CloudMessage&&)> on_message) : on_message_(std::move(on_message)) {}
+  explicit MapListener(std::function<void(MapMessage&&)> on_message) : on_message_(std::move(on_message)) {}
 
   void on_data_available(DataReader* reader) override {
-    ros_sensor::PointCloud2_ msg;
+    Msg msg;
     SampleInfo info;
     while (reader->take_next_sample(&msg, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data || seenBefore(info.sample_identity)) continue;
-      CloudMessage m;
-      m.layout.height = msg.height();
-      m.layout.width = msg.width();
-      m.layout.is_bigendian = msg.is_bigendian();
-      m.layout.point_step = msg.point_step();
-      m.layout.row_step = msg.row_step();
-      for (const auto& f : msg.fields()) m.layout.fields.push_back({f.name(), f.offset(), f.datatype(), f.count()});
-      m.data = std::move(msg.data());
-      m.frame_id = msg.header().frame_id();
-      on_message_(std::move(m));
+      on_message_(mapMessageOf(msg));
     }
   }
 
@@ -108,7 +125,7 @@ class MapListener : public DataReaderListener {
     return false;
   }
 
-  std::function<void(CloudMessage&&)> on_message_;
+  std::function<void(MapMessage&&)> on_message_;
   std::mutex mutex_;
   std::deque<eprosima::fastrtps::rtps::SampleIdentity> seen_;
 };
@@ -120,7 +137,7 @@ struct Ros2Node::Impl {
   DataWriter* diagnostics = nullptr;
   DataWriter* fleet_map = nullptr;
   DataWriter* fleet_grid = nullptr;
-  std::unique_ptr<MapListener> map_listener;
+  std::unique_ptr<DataReaderListener> map_listener;
 
   /// `topic` with its `type` registered.
   Topic* topic(TypeSupport type, const std::string& name) {
@@ -131,8 +148,9 @@ struct Ros2Node::Impl {
     return t;
   }
 
-  /// A writer of `type` on `name`.
-  DataWriter* writer(TypeSupport type, const std::string& name, const DataWriterQos& qos) {
+  /// A writer of `type` (ROS 2's `ros_type`, whose hash it carries) on `name`.
+  DataWriter* writer(TypeSupport type, const std::string& ros_type, const std::string& name, DataWriterQos qos) {
+    qos.user_data().data_vec(typeHashUserData(ros_type));
     DataWriter* w = publisher->create_datawriter(topic(std::move(type), name), qos);
     if (!w) throw std::runtime_error("cannot create the writer of " + name);
     return w;
@@ -203,18 +221,21 @@ Ros2Node::Ros2Node(int ros_domain, bool localhost_only) : impl_(std::make_unique
   i.publisher = i.participant->create_publisher(PUBLISHER_QOS_DEFAULT);
   if (!i.publisher) throw std::runtime_error("cannot create the ROS 2 publisher");
   // tf2_ros::StaticTransformBroadcaster's QoS: transient local.
-  i.tf_static = i.writer(TypeSupport(new ros_tf::TFMessage_PubSubType()), kTfStaticTopic,
+  i.tf_static = i.writer(TypeSupport(new ros_tf::TFMessage_PubSubType()), "tf2_msgs/msg/TFMessage", kTfStaticTopic,
                          reliableKeepLast1(DATAWRITER_QOS_DEFAULT, TRANSIENT_LOCAL_DURABILITY_QOS));
   // diagnostic_updater's: volatile (a late reader waits for the next).
-  i.diagnostics = i.writer(TypeSupport(new ros_diagnostic::DiagnosticArray_PubSubType()), kDiagnosticsTopic,
+  i.diagnostics = i.writer(TypeSupport(new ros_diagnostic::DiagnosticArray_PubSubType()),
+                           "diagnostic_msgs/msg/DiagnosticArray", kDiagnosticsTopic,
                            reliableKeepLast1(DATAWRITER_QOS_DEFAULT, VOLATILE_DURABILITY_QOS));
   // Map servers' QoS: transient local, so RViz started later gets the map.
   // Asynchronous: a map of megabytes leaves in fragments on Fast DDS's own
   // thread, not on the caller's.
   DataWriterQos latched = reliableKeepLast1(DATAWRITER_QOS_DEFAULT, TRANSIENT_LOCAL_DURABILITY_QOS);
   latched.publish_mode().kind = ASYNCHRONOUS_PUBLISH_MODE;
-  i.fleet_map = i.writer(TypeSupport(new ros_sensor::PointCloud2_PubSubType()), kFleetMapTopic, latched);
-  i.fleet_grid = i.writer(TypeSupport(new ros_nav::OccupancyGrid_PubSubType()), kFleetGridTopic, latched);
+  i.fleet_map =
+      i.writer(TypeSupport(new ros_sensor::PointCloud2_PubSubType()), "sensor_msgs/msg/PointCloud2", kFleetMapTopic, latched);
+  i.fleet_grid = i.writer(TypeSupport(new ros_nav::OccupancyGrid_PubSubType()), "nav_msgs/msg/OccupancyGrid",
+                          kFleetGridTopic, latched);
 }
 
 Ros2Node::~Ros2Node() = default;
@@ -313,16 +334,24 @@ void Ros2Node::publishFleetMap(const FleetMapMessage& m) {
   impl_->fleet_grid->write(&grid);
 }
 
-void Ros2Node::subscribeMap(const std::string& topic, std::function<void(CloudMessage&&)> on_message) {
+void Ros2Node::subscribeMap(const std::string& topic, MapMessageType type,
+                            std::function<void(MapMessage&&)> on_message) {
   auto& i = *impl_;
+  const bool cloud = type == MapMessageType::PointCloud2;
   // ROS 2's names: "rt" + the topic's absolute name.
-  Topic* t = i.topic(TypeSupport(new ros_sensor::PointCloud2_PubSubType()),
+  Topic* t = i.topic(cloud ? TypeSupport(new ros_sensor::PointCloud2_PubSubType())
+                           : TypeSupport(new ros_octomap::Octomap_PubSubType()),
                      "rt" + (topic.rfind('/', 0) == 0 ? topic : "/" + topic));
   Subscriber* subscriber = i.participant->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
   if (!subscriber) throw std::runtime_error("cannot subscribe to " + topic);
-  i.map_listener = std::make_unique<MapListener>(std::move(on_message));
+  if (cloud)
+    i.map_listener = std::make_unique<MapListener<ros_sensor::PointCloud2_>>(std::move(on_message));
+  else
+    i.map_listener = std::make_unique<MapListener<ros_octomap::Octomap_>>(std::move(on_message));
   for (const DurabilityQosPolicyKind durability : {TRANSIENT_LOCAL_DURABILITY_QOS, VOLATILE_DURABILITY_QOS}) {
-    if (!subscriber->create_datareader(t, reliableKeepLast1(DATAREADER_QOS_DEFAULT, durability), i.map_listener.get()))
+    DataReaderQos q = reliableKeepLast1(DATAREADER_QOS_DEFAULT, durability);
+    q.user_data().data_vec(typeHashUserData(cloud ? "sensor_msgs/msg/PointCloud2" : "octomap_msgs/msg/Octomap"));
+    if (!subscriber->create_datareader(t, q, i.map_listener.get()))
       throw std::runtime_error("cannot create the reader of " + topic);
   }
 }

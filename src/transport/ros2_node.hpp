@@ -10,6 +10,7 @@
 // nodes see them with no ROS 2 dependency here (docs/operations.md, "ROS 2").
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,10 +34,22 @@ struct Diagnostic {
   std::vector<std::pair<std::string, std::string>> values;  ///< key, value
 };
 
-/// One sensor_msgs/PointCloud2 as it arrived, undecoded (io/point_cloud2.hpp
-/// reads it): decoding a large map is left to whoever has time for it.
-struct CloudMessage {
-  PointCloud2Layout layout;
+/// The message types a map can come in.
+enum class MapMessageType { PointCloud2, Octomap };
+
+/// octomap_msgs/Octomap's description of its tree.
+struct OctomapTree {
+  bool binary = true;  ///< occupancy only (a .bt's content); false: the full tree (a .ot's)
+  std::string id;      ///< the tree's class, e.g. "OcTree"
+  double resolution = 0;
+};
+
+/// One map message as it arrived, undecoded (io/point_cloud2.hpp,
+/// io/octomap_io.hpp read it): decoding a large map is left to whoever has
+/// time for it.
+struct MapMessage {
+  PointCloud2Layout layout;           ///< a PointCloud2's
+  std::optional<OctomapTree> octomap; ///< an Octomap's (then `layout` is unused)
   std::vector<uint8_t> data;
   std::string frame_id;
 };
@@ -72,12 +85,13 @@ class Ros2Node {
   /// float32, label as uint32, a point per cell) and /fleet_map_grid
   /// (OccupancyGrid), both latched (transient local, keep last 1).
   void publishFleetMap(const FleetMapMessage& m);
-  /// Reads sensor_msgs/PointCloud2 from the ROS 2 topic `topic` (e.g.
-  /// /Laser_map) with the QoS SLAM packages publish maps with: reliable, keep
+  /// Reads maps of `type` (sensor_msgs/PointCloud2, octomap_msgs/Octomap)
+  /// from the ROS 2 topic `topic` (e.g. /Laser_map, /octomap_binary) with the
+  /// QoS SLAM packages and octomap_server publish maps with: reliable, keep
   /// last 1, volatile or transient local (a latched map that was published
   /// before this node started arrives too). Each new message goes to
   /// `on_message`, on a DDS thread. Throws std::runtime_error if DDS refuses.
-  void subscribeMap(const std::string& topic, std::function<void(CloudMessage&&)> on_message);
+  void subscribeMap(const std::string& topic, MapMessageType type, std::function<void(MapMessage&&)> on_message);
 
  private:
   struct Impl;

@@ -1,13 +1,16 @@
 // The fleet's map as a user finds it: built by a daemon from the slices it
 // holds (its own and those its peers sent for matching), in files beside
 // transforms.json and on ROS 2's /fleet_map and /fleet_map_grid, read by a
-// ROS 2 node of the other DDS vendor, early or late; and following a map update.
+// ROS 2 node of the other DDS vendor, early or late; and following a map
+// update. One robot's map comes from octomap_server's topic.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <future>
 #include <unordered_set>
+
+#include <octomap/OcTree.h>
 
 #include "cyclone_reader.hpp"
 #include "fleet.hpp"
@@ -68,6 +71,15 @@ double shareCovered(const Points& merged, const Points& pillar, const Eigen::Mat
   return pillar.empty() ? 0.0 : static_cast<double>(covered) / static_cast<double>(pillar.size());
 }
 
+/// `map` as octomap_server publishes it on /octomap_binary: an OcTree of
+/// `resolution`, its binary data (OcTree::writeBinaryData) written to `path`.
+void writeOctomapData(const std::string& path, const Points& map, double resolution) {
+  octomap::OcTree tree(resolution);
+  for (const auto& p : map) tree.updateNode(octomap::point3d(p.x(), p.y(), p.z()), true);
+  std::ofstream out(path, std::ios::binary);
+  ASSERT_TRUE(tree.writeBinaryData(out));
+}
+
 }  // namespace
 
 TEST(FleetMap, ADaemonMergesTheSlicesItHoldsNearTheTruthForRos2ReadersEarlyAndLateAndFollowsAnUpdate) {
@@ -80,11 +92,15 @@ TEST(FleetMap, ADaemonMergesTheSlicesItHoldsNearTheTruthForRos2ReadersEarlyAndLa
   savePcd(dir / "charlie.pcd", charlie_map);
   const int domain = 100 + static_cast<int>(::getpid() % 100);
   Fleet fleet(dir);
-  std::vector<AgentSpec> agents{{"alpha", world + "/map_0.pcd", kGrid},
-                                {"bravo", world + "/map_1.pcd", kGrid},
-                                {"charlie", dir / "charlie.pcd", kGrid}};
-  // alpha alone speaks ROS 2 (one publisher of the map), and builds as often as allowed.
-  agents[0].extra = "[ros2]\ndomain = " + std::to_string(domain) + "\n[fleet_map]\ninterval_s = 1\n";
+  std::vector<AgentSpec> agents{
+      {"alpha", world + "/map_0.pcd", kGrid}, {"bravo", "", kGrid}, {"charlie", dir / "charlie.pcd", kGrid}};
+  // alpha builds the map as often as allowed and publishes it; bravo reads
+  // its own map from octomap_server's topic and publishes no fleet map (one publisher).
+  const std::string ros2 = "[ros2]\ndomain = " + std::to_string(domain) + "\n";
+  agents[0].extra = ros2 + "[fleet_map]\ninterval_s = 1\n";
+  agents[1].extra = ros2 + "map_topic = \"/bravo/octomap_binary\"\nmap_type = \"octomap_msgs/Octomap\"\n" +
+                    "[fleet_map]\nenabled = false\n";
+  writeOctomapData(dir / "bravo.octomap", loadMap(world + "/map_1.pcd"), 0.05);
   // A node that joined before the map existed: it gets each new map as published.
   auto early = std::async(std::launch::async, [&] {
     std::string output;
@@ -93,6 +109,11 @@ TEST(FleetMap, ADaemonMergesTheSlicesItHoldsNearTheTruthForRos2ReadersEarlyAndLa
   });
   for (const auto& a : agents) fleet.start(a, agents);
   const std::vector<std::string> ids{"alpha", "bravo", "charlie"};
+  const auto octomap = runBinary("env", "CYCLONEDDS_URI='" + kJazzyLocalhost.cyclonedds_uri +
+                                            "' " CYCLONE_CLOUD_PUBLISHER_BIN " " + std::to_string(domain) +
+                                            " /bravo/octomap_binary " + (dir / "bravo.octomap") +
+                                            " octomap-binary@0.05 bravo_odom 120");
+  ASSERT_EQ(octomap.exit_code, 0) << octomap.output << fleet.log("bravo");
   ASSERT_TRUE(Fleet::waitFor([&] { return robotsInFleetMap(fleet, "alpha") == 3; }, 600s))
       << fleet.readJson("alpha", "status.json").dump(2) << fleet.log("alpha");
 
@@ -111,6 +132,8 @@ TEST(FleetMap, ADaemonMergesTheSlicesItHoldsNearTheTruthForRos2ReadersEarlyAndLa
   EXPECT_NE(readText(dir / "out-alpha/fleet_map.yaml").find("image: fleet_map.pgm"), std::string::npos);
   EXPECT_GT(std::filesystem::file_size(dir / "out-alpha/fleet_map.png"), 10'000u);
   EXPECT_NE(fleet.log("alpha").find("fleet map: "), std::string::npos) << fleet.log("alpha");
+  EXPECT_NE(fleet.log("bravo").find("(octomap_msgs/Octomap)"), std::string::npos) << fleet.log("bravo");
+  EXPECT_EQ(fleet.readJson("bravo", "status.json")["map"]["frame_id"], "bravo_odom");
   // Every daemon builds it (without ROS 2: the files).
   EXPECT_TRUE(Fleet::waitFor([&] { return robotsInFleetMap(fleet, "charlie") == 3; }, 120s))
       << fleet.readJson("charlie", "status.json").dump(2);
@@ -136,6 +159,9 @@ TEST(FleetMap, ADaemonMergesTheSlicesItHoldsNearTheTruthForRos2ReadersEarlyAndLa
   EXPECT_EQ(grid["occupied"].get<size_t>() + grid["unknown"].get<size_t>(), grid["cells"].get<size_t>())
       << "occupied or unknown: slices carry no free space";
   EXPECT_GT(grid["occupied"].get<size_t>(), grid["cells"].get<size_t>() / 50) << "the building's walls";
+  // The type hashes Jazzy's nodes carry (`ros2 topic info -v`; PointCloud2's is rcl's own test's).
+  EXPECT_EQ(cloud["user_data"], "typehash=RIHS01_9198cabf7da3796ae6fe19c4cb3bdd3525492988c70522628af5daa124bae2b5;");
+  EXPECT_EQ(grid["user_data"], "typehash=RIHS01_8d348150c12913a31ee0ec170fbf25089e4745d17035792a1ba94d6f0bc0cfc7;");
 
   // charlie's robot maps a pillar: the fleet's map follows.
   const Points pillar = pillarFor(charlie_map);

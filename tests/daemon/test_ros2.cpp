@@ -242,6 +242,8 @@ TEST(Ros2, CycloneAndFastDdsNodesReadTfStaticUnderEachDiscoverySettingAndDiagnos
     EXPECT_EQ(t["qx"].get<double>(), 0.0);
     EXPECT_EQ(t["qy"].get<double>(), 0.0);
     EXPECT_GT(t["sec"].get<int64_t>(), 1'600'000'000) << "stamped with the wall clock";
+    // The type hash Jazzy's nodes carry (`ros2 topic info -v /tf_static`): rmw warns on endpoints without it.
+    EXPECT_EQ(got["user_data"], "typehash=RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087;");
   }
 
   {

@@ -1,13 +1,17 @@
 /* A SLAM package's map topic, as a ROS 2 node publishes it through Eclipse
- * Cyclone DDS (rmw_cyclonedds's DDS): sensor_msgs/PointCloud2 with types from
- * ROS 2's .msg files (ros2_messages.idl), reliable, transient local, keep
- * last 1 (a latched map, as octomap_server and RTAB-Map publish theirs).
+ * Cyclone DDS (rmw_cyclonedds's DDS): sensor_msgs/PointCloud2 or
+ * octomap_msgs/Octomap with types from ROS 2's .msg files
+ * (ros2_messages.idl), reliable, transient local, keep last 1 (a latched map,
+ * as octomap_server and RTAB-Map publish theirs).
  *
  * Usage: cyclone_cloud_publisher DOMAIN TOPIC POINTS LAYOUT FRAME SECONDS
- *   POINTS  a file of float32 x, y, z triples
+ *   POINTS  a file of float32 x, y, z triples; for an Octomap, the tree's
+ *           data as octomap_server puts it in the message
  *   LAYOUT  xyzi32: x, y, z, intensity as float32 (16 bytes a point, one row);
  *           xyz64: x, y, z as float64 and 8 bytes of padding (32 bytes a
- *           point), organised in two rows, the second padded by 16 bytes
+ *           point), organised in two rows, the second padded by 16 bytes;
+ *           octomap-binary@RES, octomap-full@RES: an Octomap of an OcTree of
+ *           resolution RES [m], binary (occupancy) or full
  * Waits for a reader, publishes one message, and exits 0 once every matched
  * reader acknowledged it; 1 if none matched or acknowledged within SECONDS. */
 #include <stdio.h>
@@ -29,8 +33,74 @@ static void put_field(sensor_msgs_msg_dds__PointField_* f, const char* name, uin
   f->count = 1;
 }
 
+/* Publishes `sample` of `type` on ROS 2 topic `topic` once a reader matched,
+ * and waits until every matched reader acknowledged it. */
+static int publish(const char* domain, const char* topic, const dds_topic_descriptor_t* type, const void* sample,
+                   const char* what, const char* seconds) {
+  const dds_entity_t participant = dds_create_participant((dds_domainid_t)atoi(domain), NULL, NULL);
+  if (participant < 0) return fail("dds_create_participant failed");
+  char topic_name[512];
+  snprintf(topic_name, sizeof topic_name, "rt%s%s", topic[0] == '/' ? "" : "/", topic);
+  const dds_entity_t t = dds_create_topic(participant, type, topic_name, NULL, NULL);
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(10));
+  dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
+  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+  const dds_entity_t writer = dds_create_writer(participant, t, qos, NULL);
+  dds_delete_qos(qos);
+  if (t < 0 || writer < 0) return fail("cannot create the writer");
+  dds_set_status_mask(writer, DDS_PUBLICATION_MATCHED_STATUS);
+
+  const dds_time_t deadline = dds_time() + DDS_SECS(atoi(seconds));
+  dds_publication_matched_status_t matched = {0};
+  while (matched.current_count == 0 && dds_time() < deadline) {
+    dds_get_publication_matched_status(writer, &matched);
+    if (matched.current_count == 0) dds_sleepfor(DDS_MSECS(50));
+  }
+  int code = 1;
+  if (matched.current_count > 0 && dds_write(writer, sample) == DDS_RETCODE_OK &&
+      dds_wait_for_acks(writer, deadline - dds_time()) == DDS_RETCODE_OK) {
+    printf("published %s on %s; %d readers acknowledged\n", what, topic_name, (int)matched.current_count);
+    code = 0;
+  } else {
+    fprintf(stderr, "cyclone_cloud_publisher: no reader acknowledged %s within %s s\n", topic_name, seconds);
+  }
+  dds_delete(participant);
+  return code;
+}
+
+/* An Octomap of the tree data in `path`: `layout` octomap-binary@RES or octomap-full@RES. */
+static int publish_octomap(char** argv) {
+  const char* layout = argv[4];
+  const int binary = strncmp(layout, "octomap-binary@", 15) == 0;
+  if (!binary && strncmp(layout, "octomap-full@", 13) != 0) return fail("LAYOUT: octomap-binary@RES or octomap-full@RES");
+  FILE* in = fopen(argv[3], "rb");
+  if (!in) return fail("cannot open the tree's data");
+  fseek(in, 0, SEEK_END);
+  const long bytes = ftell(in);
+  fseek(in, 0, SEEK_SET);
+  int8_t* data = malloc((size_t)bytes + 1);
+  if (!data || fread(data, 1, (size_t)bytes, in) != (size_t)bytes) return fail("cannot read the tree's data");
+  fclose(in);
+  octomap_msgs_msg_dds__Octomap_ msg;
+  memset(&msg, 0, sizeof msg);
+  msg.header.frame_id = argv[5];
+  msg.header.stamp.sec = 1700000000;
+  msg.binary = binary;
+  msg.id = "OcTree";
+  msg.resolution = atof(strchr(layout, '@') + 1);
+  msg.data._buffer = data;
+  msg.data._length = msg.data._maximum = (uint32_t)bytes;
+  char what[128];
+  snprintf(what, sizeof what, "an Octomap (%s, %ld bytes)", binary ? "binary" : "full", bytes);
+  const int code = publish(argv[1], argv[2], &octomap_msgs_msg_dds__Octomap__desc, &msg, what, argv[6]);
+  free(data);
+  return code;
+}
+
 int main(int argc, char** argv) {
   if (argc != 7) return fail("usage: DOMAIN TOPIC POINTS LAYOUT FRAME SECONDS");
+  if (strncmp(argv[4], "octomap", 7) == 0) return publish_octomap(argv);
   const int wide = strcmp(argv[4], "xyz64") == 0;
   if (!wide && strcmp(argv[4], "xyzi32") != 0) return fail("LAYOUT must be xyzi32 or xyz64");
   FILE* in = fopen(argv[3], "rb");
@@ -88,37 +158,9 @@ int main(int argc, char** argv) {
   msg.data._buffer = data;
   msg.data._length = msg.data._maximum = (uint32_t)size;
 
-  const dds_entity_t participant = dds_create_participant((dds_domainid_t)atoi(argv[1]), NULL, NULL);
-  if (participant < 0) return fail("dds_create_participant failed");
-  char topic_name[512];
-  snprintf(topic_name, sizeof topic_name, "rt%s%s", argv[2][0] == '/' ? "" : "/", argv[2]);
-  const dds_entity_t topic =
-      dds_create_topic(participant, &sensor_msgs_msg_dds__PointCloud2__desc, topic_name, NULL, NULL);
-  dds_qos_t* qos = dds_create_qos();
-  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(10));
-  dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);
-  dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
-  const dds_entity_t writer = dds_create_writer(participant, topic, qos, NULL);
-  dds_delete_qos(qos);
-  if (topic < 0 || writer < 0) return fail("cannot create the writer");
-  dds_set_status_mask(writer, DDS_PUBLICATION_MATCHED_STATUS);
-
-  const dds_time_t deadline = dds_time() + DDS_SECS(atoi(argv[6]));
-  dds_publication_matched_status_t matched = {0};
-  while (matched.current_count == 0 && dds_time() < deadline) {
-    dds_get_publication_matched_status(writer, &matched);
-    if (matched.current_count == 0) dds_sleepfor(DDS_MSECS(50));
-  }
-  int code = 1;
-  if (matched.current_count > 0 && dds_write(writer, &msg) == DDS_RETCODE_OK &&
-      dds_wait_for_acks(writer, deadline - dds_time()) == DDS_RETCODE_OK) {
-    printf("published %u points (%zu bytes, %s) on %s; %d readers acknowledged\n", n, size, argv[4], topic_name,
-           (int)matched.current_count);
-    code = 0;
-  } else {
-    fprintf(stderr, "cyclone_cloud_publisher: no reader acknowledged %s within %s s\n", topic_name, argv[6]);
-  }
-  dds_delete(participant);
+  char what[128];
+  snprintf(what, sizeof what, "%u points (%zu bytes, %s)", n, size, argv[4]);
+  const int code = publish(argv[1], argv[2], &sensor_msgs_msg_dds__PointCloud2__desc, &msg, what, argv[6]);
   for (uint32_t k = 0; k < fields; ++k) free(msg.fields._buffer[k].name);
   free(msg.fields._buffer);
   free(data);

@@ -16,8 +16,9 @@
  *        cyclone_ros2_reader fleet_map_grid DOMAIN OCCUPIED SECONDS
  *          a map display or a costmap's static layer (the same QoS); done once an
  *          OccupancyGrid holds OCCUPIED occupied cells or more.
- * Prints each sample that arrives as one JSON line; exits 0 when done, 1 if
- * not within SECONDS, 2 on bad use. */
+ * Prints each sample that arrives as one JSON line, with its publisher's
+ * USER_DATA (where ROS 2 endpoints carry their type hash); exits 0 when done,
+ * 1 if not within SECONDS, 2 on bad use. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -62,7 +63,7 @@ static int take_tf(const void* sample, const char* wanted) {
         t->transform.translation.z, t->transform.rotation.x, t->transform.rotation.y, t->transform.rotation.z,
         t->transform.rotation.w);
   }
-  printf("]}\n");
+  printf("]");
   return m->transforms._length >= (uint32_t)atoi(wanted);
 }
 
@@ -93,7 +94,7 @@ static int take_diagnostics(const void* sample, const char* wanted) {
     }
     printf("}}");
   }
-  printf("]}\n");
+  printf("]");
   return found;
 }
 
@@ -140,7 +141,6 @@ static int take_cloud(const void* sample, const char* wanted) {
     }
     printf("], \"min\": [%g, %g, %g], \"max\": [%g, %g, %g]", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
   }
-  printf("}\n");
   return robots >= atoi(wanted);
 }
 
@@ -161,7 +161,7 @@ static int take_grid(const void* sample, const char* wanted) {
   print_string(m->header.frame_id);
   printf(", \"sec\": %d, \"resolution\": %.9g, \"width\": %u, \"height\": %u, \"cells\": %u, "
          "\"origin\": {\"x\": %.17g, \"y\": %.17g, \"z\": %.17g, \"qx\": %.17g, \"qy\": %.17g, \"qz\": %.17g, "
-         "\"qw\": %.17g}, \"occupied\": %u, \"free\": %u, \"unknown\": %u, \"other\": %u}\n",
+         "\"qw\": %.17g}, \"occupied\": %u, \"free\": %u, \"unknown\": %u, \"other\": %u",
          m->header.stamp.sec, (double)info->resolution, info->width, info->height, m->data._length,
          info->origin.position.x, info->origin.position.y, info->origin.position.z, info->origin.orientation.x,
          info->origin.orientation.y, info->origin.orientation.z, info->origin.orientation.w, occupied, free_cells,
@@ -221,7 +221,24 @@ int main(int argc, char** argv) {
     dds_sample_info_t infos[1];
     const dds_return_t n = dds_take(reader, samples, infos, 1, 1);
     if (n > 0) {
-      if (infos[0].valid_data) done = mode->take(samples[0], argv[3]);
+      if (infos[0].valid_data) {
+        done = mode->take(samples[0], argv[3]);
+        /* What rmw_cyclonedds reads the type hash from: the publisher's USER_DATA. */
+        char user_data[256] = "";
+        dds_builtintopic_endpoint_t* publisher = dds_get_matched_publication_data(reader, infos[0].publication_handle);
+        if (publisher) {
+          void* value = NULL;
+          size_t size = 0;
+          if (dds_qget_userdata(publisher->qos, &value, &size) && value) {
+            snprintf(user_data, sizeof user_data, "%.*s", (int)size, (const char*)value);
+            dds_free(value);
+          }
+          dds_builtintopic_free_endpoint(publisher);
+        }
+        printf(", \"user_data\": ");
+        print_string(user_data);
+        printf("}\n");
+      }
       fflush(stdout);
       dds_return_loan(reader, samples, n);
     } else {

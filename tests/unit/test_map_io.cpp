@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
+#include <sstream>
+
 #include <fstream>
 
 #include "io/map_io.hpp"
+#include "io/octomap_io.hpp"
 #include "support.hpp"
 
 using namespace tomomap;
@@ -233,6 +236,30 @@ TEST(MapIo, OctomapTreesLoadAsTheirOccupiedVoxels) {
   EXPECT_NE(errorOf([&] { loadMap(dir / "junk.bt"); }).find("junk.bt"), std::string::npos);
   write(dir / "text.ot", "not a tree at all\n");
   EXPECT_NE(errorOf([&] { loadMap(dir / "text.ot"); }).find("not a readable OctoMap tree"), std::string::npos);
+}
+
+TEST(MapIo, OctomapMessagesReadAsOctomapServerWritesThemBinaryOrFull) {
+  // What octomap_msgs's binaryMapToMsg / fullMapToMsg put in the message's data.
+  octomap::OcTree tree(0.05);
+  for (float i = 0; i < 10; ++i)
+    for (float k = 0; k < 10; ++k) tree.updateNode(octomap::point3d(0.025f + 0.05f * i, 0.025f, 0.025f + 0.05f * k), true);
+  tree.updateNode(octomap::point3d(0.5f, 0.5f, 0.5f), false);
+  const auto bytes = [](const std::string& s) { return std::vector<uint8_t>(s.begin(), s.end()); };
+  std::ostringstream binary, full;
+  ASSERT_TRUE(tree.writeBinaryData(binary));
+  ASSERT_TRUE(tree.writeData(full));
+  EXPECT_EQ(octomapFromMessage(true, "OcTree", 0.05, bytes(binary.str())).size(), 100u);
+  EXPECT_EQ(octomapFromMessage(false, "OcTree", 0.05, bytes(full.str())).size(), 100u);
+  // A truncated message, a tree octomap does not know, a tree that is not occupancy: said, not read.
+  const std::string cut = full.str().substr(0, full.str().size() / 2);
+  EXPECT_NE(errorOf([&] { octomapFromMessage(false, "OcTree", 0.05, bytes(cut)); }).find("not a tree of type OcTree"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { octomapFromMessage(false, "NoSuchTree", 0.05, bytes(full.str())); }).find("NoSuchTree"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { octomapFromMessage(false, "ColorOcTree", 0.05, bytes(full.str())); }).find("not an OcTree"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { octomapFromMessage(true, "OcTree", 0, bytes(binary.str())); }).find("resolution"),
+            std::string::npos);
 }
 
 TEST(PoseIo, RoundTripsAndRejectsBadFiles) {
