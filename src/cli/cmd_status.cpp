@@ -100,6 +100,21 @@ void printFrame(const json& frame) {
               << "not placed: no consistent transform joins it to the reference yet\n";
 }
 
+/// The daemon's last build of the fleet's map (status.json's `fleet_map`).
+void printFleetMap(const json& status) {
+  const json& m = status.value("fleet_map", json());
+  if (!m.is_object()) return;
+  if (m.contains("error")) {
+    std::cout << "  fleet map NOT built: " << m["error"].get<std::string>() << "\n";
+    return;
+  }
+  std::string robots;
+  for (const auto& r : m.value("robots", json::array()))
+    robots += (robots.empty() ? "" : ", ") + r.value("agent", "?") + " " + std::to_string(r.value("cells", 0));
+  std::cout << "  fleet map " << m.value("cells", 0) << " cells in " << m.value("frame", "?") << " (" << robots
+            << "), built " << ago(m.value("built_at_ms", 0.0)) << "\n           " << m.value("files", "") << "\n";
+}
+
 void printHuman(const json& status, const json& transforms, const json& frame, bool running) {
   const json& map = status["map"];
   std::cout << "tomomapd " << status.value("agent", "?") << ": "
@@ -177,6 +192,7 @@ void printHuman(const json& status, const json& transforms, const json& frame, b
     std::cout << "\n";
   }
   printFrame(frame);
+  printFleetMap(status);
 }
 
 int runStatus(const StatusOptions& o) {

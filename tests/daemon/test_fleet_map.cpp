@@ -132,6 +132,10 @@ TEST(FleetMap, ADaemonMergesTheSlicesItHoldsNearTheTruthForRos2ReadersEarlyAndLa
   EXPECT_NE(readText(dir / "out-alpha/fleet_map.yaml").find("image: fleet_map.pgm"), std::string::npos);
   EXPECT_GT(std::filesystem::file_size(dir / "out-alpha/fleet_map.png"), 10'000u);
   EXPECT_NE(fleet.log("alpha").find("fleet map: "), std::string::npos) << fleet.log("alpha");
+  const auto shown = runTomomap("status " + (dir / "out-alpha"));
+  EXPECT_NE(shown.output.find("fleet map " + std::to_string(merged.size()) + " cells in alpha's frame, levelled"),
+            std::string::npos)
+      << shown.output;
   EXPECT_NE(fleet.log("bravo").find("(octomap_msgs/Octomap)"), std::string::npos) << fleet.log("bravo");
   EXPECT_EQ(fleet.readJson("bravo", "status.json")["map"]["frame_id"], "bravo_odom");
   // Every daemon builds it (without ROS 2: the files).
@@ -162,6 +166,15 @@ TEST(FleetMap, ADaemonMergesTheSlicesItHoldsNearTheTruthForRos2ReadersEarlyAndLa
   // The type hashes Jazzy's nodes carry (`ros2 topic info -v`; PointCloud2's is rcl's own test's).
   EXPECT_EQ(cloud["user_data"], "typehash=RIHS01_9198cabf7da3796ae6fe19c4cb3bdd3525492988c70522628af5daa124bae2b5;");
   EXPECT_EQ(grid["user_data"], "typehash=RIHS01_8d348150c12913a31ee0ec170fbf25089e4745d17035792a1ba94d6f0bc0cfc7;");
+
+  // Under each ROS 2 discovery setting that keeps nodes on the robot (the
+  // daemon's default, localhost_only), as for /tf_static.
+  for (const Ros2Setting& setting : {kHumbleLocalhostOnly, kJazzySubnetStaticPeer}) {
+    SCOPED_TRACE(setting.name);
+    EXPECT_EQ(readWithCyclone(setting, "fleet_map_grid", domain, "1", output).value("width", 0),
+              now["grid"]["width"].get<int>())
+        << output;
+  }
 
   // charlie's robot maps a pillar: the fleet's map follows.
   const Points pillar = pillarFor(charlie_map);
