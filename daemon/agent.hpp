@@ -149,6 +149,8 @@ class Agent {
   /// Builds it anew at the next chance even if nothing it is made of changed
   /// (a new ROS 2 node, a new config).
   void refreshFleetMap() { fleet_map_parts_.clear(); }
+  /// status.json's `fleet_map`: the last build, and whether it is current.
+  nlohmann::json fleetMapStatus() const;
 
   /// One line of progress for systemd's STATUS= (and `systemctl status`).
   std::string statusLine() const;

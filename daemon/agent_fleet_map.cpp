@@ -35,6 +35,14 @@ FleetMapJob Agent::fleetMapJob() const {
   return job;
 }
 
+nlohmann::json Agent::fleetMapStatus() const {
+  if (fleet_map_status_.is_null()) return fleet_map_status_;
+  nlohmann::json s = fleet_map_status_;
+  // Made of what the map is made of now: no build is running or due.
+  s["current"] = fleet_map_.idle() && fleetMapJob().parts == fleet_map_parts_;
+  return s;
+}
+
 void Agent::followFleetMap() {
   if (fleet_map_.ready()) {
     fleet_map_status_ = fleet_map_.take();

@@ -80,7 +80,7 @@ void Agent::writeStatus(bool retry_outputs) {
         {"secure", config_.transport.security.enabled()},
         {"transforms_unwritten", outputs_.unwritten()},
         {"write_error", outputs_.writeError()},
-        {"fleet_map", fleet_map_status_}};
+        {"fleet_map", fleetMapStatus()}};
     publishDiagnostics(status);
     writeJsonAtomically((dir / "status.json").string(), status);
     status_unwritten_ = false;

@@ -24,10 +24,13 @@ namespace {
 
 constexpr double kGrid = 0.1;
 
-/// Robots in `id`'s last fleet map (status.json), 0 before the first.
+/// Robots in `id`'s last fleet map (status.json), 0 before the first or
+/// while it is not current (a build is running or due).
 size_t robotsInFleetMap(const Fleet& fleet, const std::string& id) {
   const auto status = fleet.readJson(id, "status.json");
-  if (!status.contains("fleet_map") || !status["fleet_map"].contains("robots")) return 0;
+  if (!status.contains("fleet_map") || !status["fleet_map"].contains("robots") ||
+      !status["fleet_map"].value("current", false))
+    return 0;
   return status["fleet_map"]["robots"].size();
 }
 
@@ -114,7 +117,9 @@ TEST(FleetMap, ADaemonMergesTheSlicesItHoldsNearTheTruthForRos2ReadersEarlyAndLa
                                             " /bravo/octomap_binary " + (dir / "bravo.octomap") +
                                             " octomap-binary@0.05 bravo_odom 120");
   ASSERT_EQ(octomap.exit_code, 0) << octomap.output << fleet.log("bravo");
-  ASSERT_TRUE(Fleet::waitFor([&] { return robotsInFleetMap(fleet, "alpha") == 3; }, 600s))
+  // Every pair agreed and the map built from the frame they make: nothing changes it after.
+  ASSERT_TRUE(fleet.waitForTransforms(ids, 3, 600s)) << fleet.log("alpha");
+  ASSERT_TRUE(Fleet::waitFor([&] { return robotsInFleetMap(fleet, "alpha") == 3; }, 300s))
       << fleet.readJson("alpha", "status.json").dump(2) << fleet.log("alpha");
 
   // The files: every cell where the maps merged by their true poses have one.
