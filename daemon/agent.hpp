@@ -146,6 +146,8 @@ class Agent {
   /// Takes a finished build in, and starts the next when its parts changed
   /// and the last started `[fleet_map] interval_s` ago.
   void followFleetMap();
+  /// Hands a build to ROS 2 when there is a node (what went wrong goes to its status).
+  void publishFleetMap(const FleetMapBuilt& built);
   /// Builds it anew at the next chance even if nothing it is made of changed
   /// (a new ROS 2 node, a new config).
   void refreshFleetMap() { fleet_map_parts_.clear(); }
@@ -159,12 +161,11 @@ class Agent {
   Log& log_;
   std::unique_ptr<transport::Bus> bus_;
   FleetOutputs outputs_{log_};  ///< the fleet's frame, transforms.json and frame.json, /tf_static
-  /// Shared with a fleet-map build in progress, which publishes with it.
-  std::shared_ptr<transport::Ros2Node> ros2_;
+  std::unique_ptr<transport::Ros2Node> ros2_;
   std::optional<Clock::time_point> diagnostics_published_;
   /// The latest map message from [ros2] map_topic not yet described; one at a
   /// time: a SLAM package may publish its map with every scan.
-  std::shared_ptr<const transport::MapMessage> cloud_;
+  std::shared_ptr<const transport::MapMessage> map_message_;
   std::string map_frame_id_;  ///< the frame of the map offered, when it came from a topic
   transport::BusHandlers handlers_;
   Notifier notifier_;

@@ -2,6 +2,7 @@
 // it is made of now, and when to build it again.
 #include "agent.hpp"
 #include "core/gravity.hpp"
+#include "core/text.hpp"
 #include "viz/fleet_map_picture.hpp"
 
 namespace tomomap::daemon {
@@ -19,20 +20,28 @@ FleetMapJob Agent::fleetMapJob() const {
   job.band = config_.fleet_map.band;
   job.dir = config_.output_dir;
   job.where = root + "'s frame, levelled";
-  if (ros2_) {
-    // Under a world frame the map is where the world is (the root's map
-    // levelled); else in the root's map frame, the levelling undone.
-    const bool world = !config_.ros2.world.empty();
-    const std::string frame_id = world ? config_.ros2.world : config_.ros2.frameOf(root);
-    const Eigen::Matrix4d T_frame_map =
-        world ? Eigen::Matrix4d::Identity() : Eigen::Matrix4d(levelingMatrix(root_pose->up).inverse());
-    job.publish = [node = ros2_, frame_id, T_frame_map](const FleetMap& map, const FleetGrid& grid) {
-      transport::FleetMapMessage m{&map, &grid, {}, frame_id, T_frame_map, wallMs()};
-      for (size_t r = 0; r < map.agents.size(); ++r) m.colours.push_back(viz::robotRgb(r));
-      node->publishFleetMap(m);
-    };
-  }
   return job;
+}
+
+void Agent::publishFleetMap(const FleetMapBuilt& built) {
+  const std::string root = config_.treeRoot();
+  const AgentPose* root_pose = outputs_.frame().pose(root);
+  if (!ros2_ || !built.map || !root_pose) return;
+  // Under a world frame the map is where the world is (the root's map
+  // levelled); else in the root's map frame, the levelling undone.
+  const bool world = !config_.ros2.world.empty();
+  transport::FleetMapMessage m{built.map.get(), built.grid.get(), viz::robotRgbs(built.map->agents.size()),
+                               world ? config_.ros2.world : config_.ros2.frameOf(root),
+                               world ? Eigen::Matrix4d::Identity()
+                                     : Eigen::Matrix4d(levelingMatrix(root_pose->up).inverse()),
+                               wallMs()};
+  try {
+    ros2_->publishFleetMap(m);
+    fleet_map_status_["published"] = {"/fleet_map", "/fleet_map_grid"};
+  } catch (const std::exception& e) {
+    fleet_map_status_["publish_error"] = e.what();
+    log_.warning(std::string("ROS 2: cannot publish the fleet's map: ") + e.what());
+  }
 }
 
 nlohmann::json Agent::fleetMapStatus() const {
@@ -45,17 +54,21 @@ nlohmann::json Agent::fleetMapStatus() const {
 
 void Agent::followFleetMap() {
   if (fleet_map_.ready()) {
-    fleet_map_status_ = fleet_map_.take();
-    if (fleet_map_status_.contains("error")) {
-      log_.warning("cannot build the fleet's map (trying again at the next change): " +
-                   fleet_map_status_["error"].get<std::string>());
+    const FleetMapBuilt built = fleet_map_.take();
+    fleet_map_status_ = built.status;
+    if (!built.map) {
+      log_.warning("cannot build the fleet's map (trying again in " + fixed(config_.fleet_map.interval_s, 0) +
+                   " s): " + fleet_map_status_["error"].get<std::string>());
+      refreshFleetMap();
     } else {
+      publishFleetMap(built);
       std::string robots;
       for (const auto& r : fleet_map_status_["robots"])
         robots += (robots.empty() ? "" : ", ") + r["agent"].get<std::string>() + " " + std::to_string(r["cells"].get<size_t>());
       log_.info("fleet map: " + std::to_string(fleet_map_status_["cells"].get<size_t>()) + " cells (" + robots +
                 ") in " + fleet_map_status_["frame"].get<std::string>() + ": " +
-                fleet_map_status_["files"].get<std::string>() + (ros2_ ? ", /fleet_map and /fleet_map_grid" : ""));
+                fleet_map_status_["files"].get<std::string>() +
+                (fleet_map_status_.contains("published") ? ", /fleet_map and /fleet_map_grid" : ""));
     }
   }
   if (!config_.fleet_map.enabled || !fleet_map_.idle()) return;

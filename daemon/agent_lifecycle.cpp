@@ -78,10 +78,10 @@ void Agent::followMapFile() {
   // On a helper thread: the loop keeps serving peers. It gets a copy of the
   // config (and of the message) and nothing of the agent's state.
   if (!config_.ros2.map_topic.empty()) {
-    if (!cloud_) return;
-    log_.info("map message on " + config_.ros2.map_topic + " (" + std::to_string(cloud_->data.size()) +
+    if (!map_message_) return;
+    log_.info("map message on " + config_.ros2.map_topic + " (" + std::to_string(map_message_->data.size()) +
               " bytes): describing it");
-    describing_ = std::async(std::launch::async, [config = config_, cloud = std::move(cloud_), before = described()] {
+    describing_ = std::async(std::launch::async, [config = config_, cloud = std::move(map_message_), before = described()] {
       return describeOwnMap(config, *cloud, before);
     });
     return;

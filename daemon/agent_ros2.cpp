@@ -29,7 +29,7 @@ void Agent::startRos2() {
       // has waited kMapSettle (agent_lifecycle.cpp).
       ros2_->subscribeMap(config_.ros2.map_topic, config_.ros2.map_type, [this](transport::MapMessage&& m) {
         post([this, m = std::make_shared<const transport::MapMessage>(std::move(m))] {
-          cloud_ = m;
+          map_message_ = m;
           if (!map_touched_) map_touched_ = Clock::now();
         });
       });

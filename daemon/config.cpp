@@ -171,7 +171,7 @@ void checkTogether(const Reader& r, const toml::table& root,
     }
   }
   if (c.map.empty() && c.ros2.map_topic.empty()) r.missing(root, "map");
-  if (!(c.fleet_map.band.low < c.fleet_map.band.high)) {
+  if (!c.fleet_map.band.valid()) {
     const toml::node* table = root.get("fleet_map");
     const toml::node* at = table && table->as_table() ? table->as_table()->get("band_high") : nullptr;
     r.fail(at ? *at : table ? *table : static_cast<const toml::node&>(root), "fleet_map.band_high", "must be above band_low");
@@ -201,8 +201,9 @@ std::string Config::frameReference() const {
 
 std::string Config::treeRoot() const { return ros2.root.empty() ? frameReference() : ros2.root; }
 
-const char* mapTypeName(transport::MapMessageType type) {
-  return type == transport::MapMessageType::Octomap ? "octomap_msgs/Octomap" : "sensor_msgs/PointCloud2";
+std::string mapTypeName(transport::MapMessageType type) {
+  std::string name = transport::rosTypeName(type);
+  return name.erase(name.find("/msg/"), 4);
 }
 
 std::string Ros2Config::frameOf(const std::string& agent) const {

@@ -26,16 +26,16 @@ struct Ros2Config {
   /// the root's map is the tree's root.
   std::string world;
   bool localhost_only = true;  ///< reach ROS 2 nodes on this robot only, never the robots' link
-  /// A sensor_msgs/PointCloud2 topic that carries this robot's map (its SLAM's
-  /// map cloud), instead of the `map` file; empty: the file.
+  /// A topic that carries this robot's map (its SLAM's map cloud, an
+  /// OctoMap), instead of the `map` file; empty: the file.
   std::string map_topic;
   transport::MapMessageType map_type = transport::MapMessageType::PointCloud2;  ///< what map_topic carries
 
   std::string frameOf(const std::string& agent) const;
 };
 
-/// A map message type's ROS name ("sensor_msgs/PointCloud2", "octomap_msgs/Octomap").
-const char* mapTypeName(transport::MapMessageType type);
+/// A map message type as the config names it ("sensor_msgs/PointCloud2": its ROS name without "msg/").
+std::string mapTypeName(transport::MapMessageType type);
 
 /// The [fleet_map] table: the fleet's map built here (docs/configuration.md).
 struct FleetMapConfig {

@@ -20,7 +20,7 @@ nlohmann::json coverage(const MapFeatures& m) {
   return {{"slices_with_cells", m.occupancy.occupiedSlices()}, {"slices_as_features", as_features}};
 }
 
-nlohmann::json build(const FleetMapJob& job) {
+FleetMapBuilt build(const FleetMapJob& job) {
   std::vector<PlacedMap> placed;
   nlohmann::json robots = nlohmann::json::array();
   for (const auto& part : job.parts) {
@@ -29,18 +29,19 @@ nlohmann::json build(const FleetMapJob& job) {
     robot["agent"] = part.agent;
     robots.push_back(std::move(robot));
   }
-  const FleetMap map = mergeMaps(placed, job.grid);
-  const FleetGrid grid = fleetGrid(map, job.band);
-  for (size_t r = 0; r < robots.size(); ++r) robots[r]["cells"] = map.cells_of[r];
+  auto map = std::make_shared<const FleetMap>(mergeMaps(placed, job.grid));
+  auto grid = std::make_shared<const FleetGrid>(fleetGrid(*map, job.band));
+  for (size_t r = 0; r < robots.size(); ++r) robots[r]["cells"] = map->cells_of[r];
   const std::string stem =
-      viz::writeFleetMapFiles(job.dir, map, grid, viz::fleetMapCaption(map, grid, job.band, job.where));
-  if (job.publish) job.publish(map, grid);
-  return {{"cells", map.points.size()},
-          {"robots", robots},
-          {"frame", job.where},
-          {"floor_z", grid.floor},
-          {"grid", {{"width", grid.grid.width}, {"height", grid.grid.height}, {"resolution", grid.grid.resolution}}},
-          {"files", stem + ".{pcd,pgm,yaml,png}"}};
+      viz::writeFleetMapFiles(job.dir, *map, *grid, viz::fleetMapCaption(*map, *grid, job.band, job.where));
+  const OccupancyGrid2D& g = grid->grid;
+  nlohmann::json status{{"cells", map->points.size()},
+                        {"robots", robots},
+                        {"frame", job.where},
+                        {"floor_z", grid->floor},
+                        {"grid", {{"width", g.width}, {"height", g.height}, {"resolution", g.resolution}}},
+                        {"files", stem + ".{pcd,pgm,yaml,png}"}};
+  return {std::move(status), std::move(map), std::move(grid)};
 }
 
 }  // namespace
@@ -57,23 +58,23 @@ void FleetMapBuilder::start(FleetMapJob job) {
     // must never delay (Linux gives each thread its own nice value).
     ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 19);
     const auto t0 = Clock::now();
-    nlohmann::json r;
+    FleetMapBuilt r;
     try {
       r = build(job);
     } catch (const std::exception& e) {
       // A map too large for a grid, a full disk: said in status.json and the
-      // log; the next change tries again.
-      r = {{"error", e.what()}};
+      // log; tried again after `interval_s`.
+      r.status = {{"error", e.what()}};
     }
-    r["built_at_ms"] = wallMs();
-    r["seconds"] = seconds(Clock::now() - t0);
+    r.status["built_at_ms"] = wallMs();
+    r.status["seconds"] = seconds(Clock::now() - t0);
     result_ = std::move(r);
     done_ = true;
     wake_();
   });
 }
 
-nlohmann::json FleetMapBuilder::take() {
+FleetMapBuilt FleetMapBuilder::take() {
   thread_.join();
   done_ = false;
   return std::move(result_);

@@ -2,9 +2,10 @@
 // The fleet's map, built on a thread of its own (docs/operations.md, "The
 // fleet's map"): every placed map's slices, this agent's and its peers' as
 // they arrived (no byte more on the link), merged in the tree root's map
-// levelled, written beside transforms.json and handed to ROS 2. The agent's
-// loop starts a build when what the map is made of changed and the last one
-// is old enough; it never waits for one.
+// levelled and written beside transforms.json. The agent's loop starts a
+// build when what the map is made of changed and the last one is old enough,
+// never waits for one, and hands the result to ROS 2 itself (its node is the
+// loop's to make and unmake).
 #include <atomic>
 #include <functional>
 #include <memory>
@@ -36,8 +37,13 @@ struct FleetMapJob {
   HeightBand band;
   std::string dir;    ///< the output folder
   std::string where;  ///< the picture's caption: "alpha's frame, levelled"
-  /// Hands the map to ROS 2, on the builder's thread; empty: no ROS 2 node.
-  std::function<void(const FleetMap&, const FleetGrid&)> publish;
+};
+
+/// What a build made.
+struct FleetMapBuilt {
+  nlohmann::json status;  ///< status.json's `fleet_map` (docs/json.md)
+  std::shared_ptr<const FleetMap> map;    ///< null when the build failed (`status` says why)
+  std::shared_ptr<const FleetGrid> grid;
 };
 
 class FleetMapBuilder {
@@ -52,15 +58,14 @@ class FleetMapBuilder {
   void start(FleetMapJob job);
   bool idle() const { return !thread_.joinable(); }
   bool ready() const { return done_; }
-  /// status.json's `fleet_map` of the build just done (docs/json.md), once
-  /// ready(); the builder is idle again afterwards.
-  nlohmann::json take();
+  /// The build just done, once ready(); the builder is idle again afterwards.
+  FleetMapBuilt take();
 
  private:
   std::function<void()> wake_;
   std::thread thread_;
   std::atomic<bool> done_{false};
-  nlohmann::json result_;
+  FleetMapBuilt result_;
 };
 
 }  // namespace tomomap::daemon

@@ -17,6 +17,16 @@ inline Eigen::Matrix4d truthOf(const std::string& world, int i) {
          loadPoseFile(world + "/map_" + std::to_string(i) + "-gtpose.txt").inverse();
 }
 
+/// Whether `p` lies in one of `cells` (lattice keys at `grid`) or in one of its 26 neighbours.
+inline bool nearACell(const std::unordered_set<uint64_t>& cells, const Eigen::Vector3f& p, double grid) {
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz)
+        if (cells.count(latticeKey(p + Eigen::Vector3i(dx, dy, dz).cast<float>() * static_cast<float>(grid), grid)))
+          return true;
+  return false;
+}
+
 /// The share of `merged`'s cells (in map 0's frame) within one cell (a
 /// neighbour on the lattice of `grid`) of a cell of `world`'s first `maps`
 /// maps merged by their true poses.
@@ -28,15 +38,7 @@ inline double shareNearTheTruth(const std::string& world, const Points& merged, 
   std::unordered_set<uint64_t> cells;
   for (const auto& p : mergeMaps(truth, grid).points) cells.insert(latticeKey(p, grid));
   size_t near = 0;
-  for (const auto& p : merged) {
-    bool found = false;
-    for (int dx = -1; dx <= 1 && !found; ++dx)
-      for (int dy = -1; dy <= 1 && !found; ++dy)
-        for (int dz = -1; dz <= 1 && !found; ++dz)
-          found = cells.count(latticeKey(p + Eigen::Vector3i(dx, dy, dz).cast<float>() * static_cast<float>(grid),
-                                         grid)) > 0;
-    near += found;
-  }
+  for (const auto& p : merged) near += nearACell(cells, p, grid);
   return merged.empty() ? 0.0 : static_cast<double>(near) / static_cast<double>(merged.size());
 }
 

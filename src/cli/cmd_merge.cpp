@@ -119,7 +119,7 @@ FleetFrame matchAll(const std::vector<NamedMap>& maps, const std::vector<MapFeat
 
 int runMerge(const MergeOptions& o) {
   const std::vector<NamedMap> maps = namedMaps(o.maps);
-  if (o.band.size() != 2 || !(o.band[0] < o.band[1])) throw InputError("--band must be LOW,HIGH with LOW < HIGH");
+  if (o.band.size() != 2 || !HeightBand{o.band[0], o.band[1]}.valid()) throw InputError("--band must be LOW,HIGH with LOW < HIGH");
   std::error_code ec;  // checked before the work, so a typo costs no time
   fs::create_directories(o.out, ec);
   if (ec || !fs::is_directory(o.out)) throw InputError(o.out + ": cannot create the output folder: " + ec.message());

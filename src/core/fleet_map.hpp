@@ -51,6 +51,7 @@ double floorHeight(const FleetMap& map);
 /// reaches a person's shoulder: a wheeled robot's sensors and arm.
 struct HeightBand {
   double low = 0.2, high = 1.5;
+  bool valid() const { return low < high; }
 };
 
 /// A 2D occupancy grid in ROS's nav_msgs/OccupancyGrid convention: row 0 at

@@ -16,6 +16,7 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 
@@ -31,6 +32,10 @@ namespace ros_diagnostic = diagnostic_msgs::msg::dds_;
 namespace ros_sensor = sensor_msgs::msg::dds_;
 namespace ros_nav = nav_msgs::msg::dds_;
 namespace ros_octomap = octomap_msgs::msg::dds_;
+
+const char* rosTypeName(MapMessageType type) {
+  return type == MapMessageType::Octomap ? "octomap_msgs/msg/Octomap" : "sensor_msgs/msg/PointCloud2";
+}
 
 /// ROS 2's names: topic "rt/" + the ROS topic name.
 constexpr const char* kTfStaticTopic = "rt/tf_static";
@@ -296,6 +301,9 @@ void Ros2Node::publishFleetMap(const FleetMapMessage& m) {
     offset += 4;
   }
   constexpr uint32_t kStep = 20;
+  // A message's sizes are 32-bit: 214 M cells (4 GB) at most.
+  if (map.points.size() > std::numeric_limits<uint32_t>::max() / kStep)
+    throw std::runtime_error("a fleet map of " + std::to_string(map.points.size()) + " cells is too large for a PointCloud2");
   cloud.height(1);
   cloud.width(static_cast<uint32_t>(map.points.size()));
   cloud.is_bigendian(false);
@@ -312,7 +320,7 @@ void Ros2Node::publishFleetMap(const FleetMapMessage& m) {
     std::memcpy(out + 12, &rgb, 4);
     std::memcpy(out + 16, &label, 4);
   }
-  impl_->fleet_map->write(&cloud);
+  if (!impl_->fleet_map->write(&cloud)) throw std::runtime_error("DDS refused the PointCloud2 of the fleet's map");
 
   const OccupancyGrid2D& g = m.grid->grid;
   ros_nav::OccupancyGrid_ grid;
@@ -331,7 +339,7 @@ void Ros2Node::publishFleetMap(const FleetMapMessage& m) {
   grid.info().origin().position().z(corner.z());
   grid.info().origin().orientation(rosQuaternion(m.T_frame_map.topLeftCorner<3, 3>()));
   grid.data().assign(g.cells.begin(), g.cells.end());
-  impl_->fleet_grid->write(&grid);
+  if (!impl_->fleet_grid->write(&grid)) throw std::runtime_error("DDS refused the OccupancyGrid of the fleet's map");
 }
 
 void Ros2Node::subscribeMap(const std::string& topic, MapMessageType type,
@@ -350,7 +358,7 @@ void Ros2Node::subscribeMap(const std::string& topic, MapMessageType type,
     i.map_listener = std::make_unique<MapListener<ros_octomap::Octomap_>>(std::move(on_message));
   for (const DurabilityQosPolicyKind durability : {TRANSIENT_LOCAL_DURABILITY_QOS, VOLATILE_DURABILITY_QOS}) {
     DataReaderQos q = reliableKeepLast1(DATAREADER_QOS_DEFAULT, durability);
-    q.user_data().data_vec(typeHashUserData(cloud ? "sensor_msgs/msg/PointCloud2" : "octomap_msgs/msg/Octomap"));
+    q.user_data().data_vec(typeHashUserData(rosTypeName(type)));
     if (!subscriber->create_datareader(t, q, i.map_listener.get()))
       throw std::runtime_error("cannot create the reader of " + topic);
   }

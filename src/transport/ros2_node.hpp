@@ -36,6 +36,8 @@ struct Diagnostic {
 
 /// The message types a map can come in.
 enum class MapMessageType { PointCloud2, Octomap };
+/// Its ROS name: "sensor_msgs/msg/PointCloud2", "octomap_msgs/msg/Octomap".
+const char* rosTypeName(MapMessageType type);
 
 /// octomap_msgs/Octomap's description of its tree.
 struct OctomapTree {
@@ -83,7 +85,8 @@ class Ros2Node {
   void publishDiagnostics(const std::vector<Diagnostic>& statuses, uint64_t stamp_ms);
   /// Replaces the fleet's map: /fleet_map (PointCloud2: x, y, z, rgb as
   /// float32, label as uint32, a point per cell) and /fleet_map_grid
-  /// (OccupancyGrid), both latched (transient local, keep last 1).
+  /// (OccupancyGrid), both latched (transient local, keep last 1). Throws
+  /// std::runtime_error if a map is too large for a message or DDS refuses it.
   void publishFleetMap(const FleetMapMessage& m);
   /// Reads maps of `type` (sensor_msgs/PointCloud2, octomap_msgs/Octomap)
   /// from the ROS 2 topic `topic` (e.g. /Laser_map, /octomap_binary) with the

@@ -1,7 +1,5 @@
 #include "fleet_map_files.hpp"
 
-#include <unistd.h>
-
 #include <filesystem>
 
 #include "canvas.hpp"
@@ -24,17 +22,17 @@ std::vector<std::string> fleetMapCaption(const FleetMap& map, const FleetGrid& g
 
 std::string writeFleetMapFiles(const std::string& dir, const FleetMap& map, const FleetGrid& grid,
                                const std::vector<std::string>& caption) {
-  const fs::path staging = fs::path(dir) / (".fleet_map." + std::to_string(::getpid()));
+  // One name: what a write that was killed left (the process's exit does not
+  // wait for a build) goes with the next write.
+  const fs::path staging = fs::path(dir) / ".fleet_map.staging";
   std::error_code ec;
-  fs::remove_all(staging, ec);  // left by a write that was killed
+  fs::remove_all(staging, ec);
   if (!fs::create_directories(staging, ec))
     throw InputError(staging.string() + ": cannot create a folder to write the fleet map in: " + ec.message());
   const auto cleanUp = [&] { fs::remove_all(staging, ec); };
   try {
     const std::string stem = (staging / "fleet_map").string();
-    std::vector<uint32_t> colours;
-    for (size_t r = 0; r < map.agents.size(); ++r) colours.push_back(robotRgb(r));
-    saveLabelledPcd(stem + ".pcd", map.points, map.robot, colours);
+    saveLabelledPcd(stem + ".pcd", map.points, map.robot, robotRgbs(map.agents.size()));
     saveMapServerMap(stem, grid.grid);
     writePng(stem + ".png", drawFleetMap(map, grid.z_low, grid.z_high, caption));
     for (const char* ext : {".pgm", ".yaml", ".pcd", ".png"}) {

@@ -16,7 +16,7 @@ std::vector<std::string> fleetMapCaption(const FleetMap& map, const FleetGrid& g
                                          const std::string& where);
 
 /// Writes DIR/fleet_map.{pcd,pgm,yaml,png}; returns DIR/fleet_map. Each file
-/// is written in a folder of its own inside `dir` and renamed over its name,
+/// is written in DIR/.fleet_map.staging and renamed over its name,
 /// so that a reader finds the old file or the new one, never half of one (the
 /// PGM before the YAML that names it). Throws InputError naming the file that
 /// cannot be written; the files already renamed stay.

@@ -15,6 +15,12 @@ uint32_t robotRgb(size_t i) {
   return (static_cast<uint32_t>(c[2]) << 16) | (static_cast<uint32_t>(c[1]) << 8) | static_cast<uint32_t>(c[0]);
 }
 
+std::vector<uint32_t> robotRgbs(size_t n) {
+  std::vector<uint32_t> rgb;
+  for (size_t r = 0; r < n; ++r) rgb.push_back(robotRgb(r));
+  return rgb;
+}
+
 cv::Mat drawFleetMap(const FleetMap& map, double z_low, double z_high, const std::vector<std::string>& caption) {
   Eigen::Vector2d lo(INFINITY, INFINITY), hi(-INFINITY, -INFINITY);
   for (const auto& p : map.points) {

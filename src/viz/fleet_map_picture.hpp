@@ -12,6 +12,8 @@ namespace tomomap::viz {
 cv::Scalar robotColour(size_t i);
 /// The same as 0xRRGGBB (a PCD's rgb field).
 uint32_t robotRgb(size_t i);
+/// robotRgb of robots 0 to n - 1.
+std::vector<uint32_t> robotRgbs(size_t n);
 
 /// Every cell of the map whose height lies in [z_low, z_high] (the obstacles
 /// a robot of that height meets) in the colour of the robot that saw it

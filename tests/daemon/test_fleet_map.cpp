@@ -62,15 +62,9 @@ double shareCovered(const Points& merged, const Points& pillar, const Eigen::Mat
   std::unordered_set<uint64_t> cells;
   for (const auto& p : merged) cells.insert(latticeKey(p, kGrid));
   size_t covered = 0;
-  for (const auto& q : pillar) {
-    const Eigen::Vector3f p = (T.topLeftCorner<3, 3>() * q.cast<double>() + T.topRightCorner<3, 1>()).cast<float>();
-    bool found = false;
-    for (int dx = -1; dx <= 1 && !found; ++dx)
-      for (int dy = -1; dy <= 1 && !found; ++dy)
-        for (int dz = -1; dz <= 1 && !found; ++dz)
-          found = cells.count(latticeKey(p + Eigen::Vector3i(dx, dy, dz).cast<float>() * float(kGrid), kGrid)) > 0;
-    covered += found;
-  }
+  for (const auto& q : pillar)
+    covered += nearACell(
+        cells, (T.topLeftCorner<3, 3>() * q.cast<double>() + T.topRightCorner<3, 1>()).cast<float>(), kGrid);
   return pillar.empty() ? 0.0 : static_cast<double>(covered) / static_cast<double>(pillar.size());
 }
 
@@ -130,6 +124,7 @@ TEST(FleetMap, ADaemonMergesTheSlicesItHoldsNearTheTruthForRos2ReadersEarlyAndLa
               merged.size(), share);
   EXPECT_GE(share, 0.95);
   EXPECT_EQ(merged.size(), status["cells"].get<size_t>());
+  EXPECT_EQ(status["published"], nlohmann::json({"/fleet_map", "/fleet_map_grid"})) << status.dump(2);
   for (const auto& r : status["robots"]) {
     EXPECT_GT(r["cells"].get<size_t>(), 1000u) << r.dump();
     EXPECT_EQ(r["slices_as_features"].get<int>(), 0) << "every slice of this world crosses as occupancy";

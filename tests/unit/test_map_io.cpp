@@ -260,6 +260,18 @@ TEST(MapIo, OctomapMessagesReadAsOctomapServerWritesThemBinaryOrFull) {
             std::string::npos);
   EXPECT_NE(errorOf([&] { octomapFromMessage(true, "OcTree", 0, bytes(binary.str())); }).find("resolution"),
             std::string::npos);
+  // Malicious trees: every child "has children" (octomap's reader would
+  // recurse 100,000 levels deep and off the end), as a message and as files.
+  const std::string bomb(200'000, '\xff');
+  for (const bool is_binary : {true, false}) {
+    EXPECT_NE(errorOf([&] { octomapFromMessage(is_binary, "OcTree", 0.05, bytes(bomb)); }).find("below the tree's 16 levels"),
+              std::string::npos);
+  }
+  TempDir dir;
+  write(dir / "bomb.bt", "# Octomap OcTree binary file\nres 0.05\ndata\n" + bomb);
+  write(dir / "bomb.ot", "# Octomap OcTree file\nid OcTree\nsize 1\nres 0.05\ndata\n" + bomb);
+  EXPECT_NE(errorOf([&] { loadMap(dir / "bomb.bt"); }).find("below the tree's 16 levels"), std::string::npos);
+  EXPECT_NE(errorOf([&] { loadMap(dir / "bomb.ot"); }).find("below the tree's 16 levels"), std::string::npos);
 }
 
 TEST(PoseIo, RoundTripsAndRejectsBadFiles) {
