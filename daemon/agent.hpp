@@ -144,7 +144,8 @@ class Agent {
   /// What the fleet's map is made of now: every placed map held here.
   FleetMapJob fleetMapJob() const;
   /// Takes a finished build in, and starts the next when its parts changed
-  /// and the last started `[fleet_map] interval_s` ago.
+  /// and have stayed so for `[fleet_map] interval_s` (or have kept changing
+  /// for six of them), and the last started an interval ago.
   void followFleetMap();
   /// Hands a build to ROS 2 when there is a node (what went wrong goes to its status).
   void publishFleetMap(const FleetMapBuilt& built);
@@ -199,6 +200,8 @@ class Agent {
   Clock::time_point started_ = Clock::now();
   FleetMapBuilder fleet_map_{[this] { queue_cv_.notify_one(); }};
   std::vector<FleetMapPart> fleet_map_parts_;  ///< what the last build started was made of
+  std::vector<FleetMapPart> fleet_map_seen_;   ///< what the map is made of now, as last looked at
+  Clock::time_point fleet_map_seen_since_{};   ///< since when
   std::optional<Clock::time_point> fleet_map_started_;
   nlohmann::json fleet_map_status_;  ///< the last build's, for status.json; null before the first
 };

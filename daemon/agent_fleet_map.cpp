@@ -7,6 +7,13 @@
 
 namespace tomomap::daemon {
 
+namespace {
+
+/// Intervals after which a fleet map whose parts keep changing is built anyway.
+constexpr int kFleetMapOverdue = 6;
+
+}  // namespace
+
 FleetMapJob Agent::fleetMapJob() const {
   FleetMapJob job;
   const std::string root = config_.treeRoot();
@@ -73,9 +80,20 @@ void Agent::followFleetMap() {
   }
   if (!config_.fleet_map.enabled || !fleet_map_.idle()) return;
   const auto now = Clock::now();
-  if (fleet_map_started_ && now - *fleet_map_started_ < fromSeconds(config_.fleet_map.interval_s)) return;
   FleetMapJob job = fleetMapJob();
+  if (job.parts != fleet_map_seen_) {
+    fleet_map_seen_ = job.parts;
+    fleet_map_seen_since_ = now;
+  }
   if (job.parts.empty() || job.parts == fleet_map_parts_) return;
+  // At most one build an interval; and what the map is made of settles
+  // first: while pairs land one after another (a fleet agreeing, a SLAM map
+  // published with every scan) each build would be outdated by the next. A
+  // map that never settles is built every kFleetMapOverdue intervals.
+  const auto interval = fromSeconds(config_.fleet_map.interval_s);
+  const auto last = fleet_map_started_.value_or(started_);
+  if (fleet_map_started_ && now - last < interval) return;
+  if (now - fleet_map_seen_since_ < interval && now - last < kFleetMapOverdue * interval) return;
   fleet_map_parts_ = job.parts;
   fleet_map_started_ = now;
   fleet_map_.start(std::move(job));

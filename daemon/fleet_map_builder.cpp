@@ -1,7 +1,5 @@
 #include "fleet_map_builder.hpp"
 
-#include <sys/resource.h>
-#include <unistd.h>
 
 #include "clock.hpp"
 #include "viz/fleet_map_files.hpp"
@@ -53,10 +51,6 @@ FleetMapBuilder::~FleetMapBuilder() {
 void FleetMapBuilder::start(FleetMapJob job) {
   done_ = false;
   thread_ = std::thread([this, job = std::move(job)] {
-    // The lowest priority: on a robot's two cores a build of millions of cells
-    // would otherwise take its share from matching and sending, which it
-    // must never delay (Linux gives each thread its own nice value).
-    ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 19);
     const auto t0 = Clock::now();
     FleetMapBuilt r;
     try {

@@ -3,9 +3,11 @@
 // fleet's map"): every placed map's slices, this agent's and its peers' as
 // they arrived (no byte more on the link), merged in the tree root's map
 // levelled and written beside transforms.json. The agent's loop starts a
-// build when what the map is made of changed and the last one is old enough,
-// never waits for one, and hands the result to ROS 2 itself (its node is the
-// loop's to make and unmake).
+// build when what the map is made of changed and settled, never waits for
+// one, and hands the result to ROS 2 itself (its node is the loop's to make
+// and unmake). It runs at the daemon's own priority: a thread of lower
+// priority holding the process's memory map lock while it waits for a core
+// stalled a daemon's loop for 29 s among ten daemons on two cores.
 #include <atomic>
 #include <functional>
 #include <memory>

@@ -348,8 +348,9 @@ std::vector<Setting> declare() {
                   -10, 100),
             [](Config& c) { return &c.fleet_map.band.high; });
   bindField(range(d("fleet_map.interval_s", K::Number, "s", Reload::AtOnce,
-                    "build the fleet's map at most this often: again when a map or the fleet's frame changed, in "
-                    "the background (matching and sending never wait on it)"),
+                    "build the fleet's map again when a map or the fleet's frame changed and then stayed so "
+                    "this long (while they keep changing, every 6 times this), at most this often; in the "
+                    "background (matching and sending never wait on it)"),
                   1, 3600),
             [](Config& c) { return &c.fleet_map.interval_s; });
   return {d.all.begin(), d.all.end()};
