@@ -85,7 +85,8 @@ void Agent::followFleetMap() {
     fleet_map_seen_ = job.parts;
     fleet_map_seen_since_ = now;
   }
-  if (job.parts.empty() || job.parts == fleet_map_parts_) return;
+  // One map alone is no fleet's map: it is the robot's own, already in its file.
+  if (job.parts.size() < 2 || job.parts == fleet_map_parts_) return;
   // At most one build an interval; and what the map is made of settles
   // first: while pairs land one after another (a fleet agreeing, a SLAM map
   // published with every scan) each build would be outdated by the next. A
