@@ -42,6 +42,9 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # Fast DDS's own security leaks as suppressed (tests/CMakeLists.txt).
 # Six and ten daemons under ASan on two cores would take most of CI's time:
 # the three-agent fleet test runs the same code paths here, the Release run
-# above all of them.
-(cd build-asan && ctest --output-on-failure -j"$jobs" --timeout 1200 -L "unit|daemon" -E "SixAgents|TenAgents")
+# above all of them. So does the ROS 2 discovery-settings test: it reads the
+# same node under eight discovery settings, whose code the other ROS 2 and
+# fleet-map tests run here once each.
+(cd build-asan && ctest --output-on-failure -j"$jobs" --timeout 1200 -L "unit|daemon" \
+  -E "SixAgents|TenAgents|UnderEachDiscoverySetting")
 took "sanitizer tests"
