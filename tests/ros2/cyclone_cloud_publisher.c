@@ -33,6 +33,22 @@ static void put_field(sensor_msgs_msg_dds__PointField_* f, const char* name, uin
   f->count = 1;
 }
 
+/* The whole of the file `path` (NULL if it cannot be read); its size in `*bytes`. */
+static void* read_file(const char* path, long* bytes) {
+  FILE* in = fopen(path, "rb");
+  if (!in) return NULL;
+  fseek(in, 0, SEEK_END);
+  *bytes = ftell(in);
+  fseek(in, 0, SEEK_SET);
+  void* data = *bytes >= 0 ? malloc((size_t)*bytes + 1) : NULL;
+  if (data && fread(data, 1, (size_t)*bytes, in) != (size_t)*bytes) {
+    free(data);
+    data = NULL;
+  }
+  fclose(in);
+  return data;
+}
+
 /* Publishes `sample` of `type` on ROS 2 topic `topic` once a reader matched,
  * and waits until every matched reader acknowledged it. */
 static int publish(const char* domain, const char* topic, const dds_topic_descriptor_t* type, const void* sample,
@@ -74,14 +90,9 @@ static int publish_octomap(char** argv) {
   const char* layout = argv[4];
   const int binary = strncmp(layout, "octomap-binary@", 15) == 0;
   if (!binary && strncmp(layout, "octomap-full@", 13) != 0) return fail("LAYOUT: octomap-binary@RES or octomap-full@RES");
-  FILE* in = fopen(argv[3], "rb");
-  if (!in) return fail("cannot open the tree's data");
-  fseek(in, 0, SEEK_END);
-  const long bytes = ftell(in);
-  fseek(in, 0, SEEK_SET);
-  int8_t* data = malloc((size_t)bytes + 1);
-  if (!data || fread(data, 1, (size_t)bytes, in) != (size_t)bytes) return fail("cannot read the tree's data");
-  fclose(in);
+  long bytes = 0;
+  int8_t* data = read_file(argv[3], &bytes);
+  if (!data) return fail("cannot read the tree's data");
   octomap_msgs_msg_dds__Octomap_ msg;
   memset(&msg, 0, sizeof msg);
   msg.header.frame_id = argv[5];
@@ -103,15 +114,10 @@ int main(int argc, char** argv) {
   if (strncmp(argv[4], "octomap", 7) == 0) return publish_octomap(argv);
   const int wide = strcmp(argv[4], "xyz64") == 0;
   if (!wide && strcmp(argv[4], "xyzi32") != 0) return fail("LAYOUT must be xyzi32 or xyz64");
-  FILE* in = fopen(argv[3], "rb");
-  if (!in) return fail("cannot open POINTS");
-  fseek(in, 0, SEEK_END);
-  const long bytes = ftell(in);
-  fseek(in, 0, SEEK_SET);
+  long bytes = 0;
+  float* xyz = read_file(argv[3], &bytes);
+  if (!xyz) return fail("cannot read POINTS");
   const uint32_t n = (uint32_t)(bytes / 12);
-  float* xyz = malloc((size_t)n * 12 + 1);
-  if (!xyz || fread(xyz, 12, n, in) != n) return fail("cannot read POINTS");
-  fclose(in);
 
   sensor_msgs_msg_dds__PointCloud2_ msg;
   memset(&msg, 0, sizeof msg);
