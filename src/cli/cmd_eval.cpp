@@ -3,6 +3,7 @@
 // written as they finish, and a Markdown summary at the end.
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -64,7 +65,17 @@ std::string shortNumber(double v) {
   return o.str();
 }
 
-Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratch, int threads, double timeout_s) {
+/// `p`'s name as a file name: anything but letters, digits, dots and dashes made '_'.
+std::string fileNameOf(std::string name) {
+  for (char& ch : name)
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '-') ch = '_';
+  return name;
+}
+
+/// One run of `method` on `p`; with `candidates`, tomomap lists its
+/// candidates and the run's JSON is kept as OUT/results/PAIR.METHOD.json.
+Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratch, int threads, double timeout_s,
+           bool candidates) {
   Row row;
   row.pair = p.name;
   row.noise = p.noise;
@@ -78,6 +89,7 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
     argv = {siblingBinary("tomomap"), "match", "-q"};
   else
     argv = {siblingBinary("tomomap-baseline"), "--method", method};
+  if (method == "tomomap" && candidates) argv.push_back("--candidates");
   for (const auto& a : {p.target, p.source, std::string("--grid"), std::to_string(p.grid), std::string("--json"), json,
                         std::string("--gt-target"), p.gt_target, std::string("--gt-source"), p.gt_source,
                         std::string("-j"), std::to_string(threads)})
@@ -90,6 +102,11 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   if (run.timed_out) {
     row.note = "timed out after " + shortNumber(timeout_s) + " s";
     return row;
+  }
+  if (candidates && fs::exists(json)) {
+    fs::create_directories(scratch / "results");
+    fs::copy_file(json, scratch / "results" / (fileNameOf(p.name + "." + method) + ".json"),
+                  fs::copy_options::overwrite_existing);
   }
   std::ifstream in(json);
   if (run.exit_code > 1 || !in) {
@@ -208,6 +225,7 @@ struct EvalOptions {
   std::vector<std::string> methods;
   int threads = 0;
   double timeout_s = 0;  ///< per run; 0 = none
+  bool candidates = false;  ///< tomomap's runs list their candidates; every run's JSON kept in OUT/results
 };
 
 /// The suite a user's own posed sequence stands for: `pairs` seeds of it, tomomap alone.
@@ -343,7 +361,7 @@ int runEval(const EvalOptions& o) {
     for (const auto& m : methodsOf(p)) {
       // Said before it starts: a baseline run can take minutes.
       std::cerr << "[" << rows.size() + 1 << "/" << total << "] " << p.name << " " << m << ": running\n";
-      Row r = runOne(p, m, out, o.threads, o.timeout_s);
+      Row r = runOne(p, m, out, o.threads, o.timeout_s, o.candidates);
       rows.push_back(r);
       // Written as they finish: an interrupted run keeps every finished row.
       rows_csv << csv(r) << std::endl;
@@ -432,6 +450,9 @@ Command addEvalCommand(CLI::App& app) {
                   "seconds one run may take; then it is killed and its row says so (0 = none)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  sub->add_flag("--candidates", o->candidates,
+                "tomomap lists every candidate pose (tomomap match --candidates) and each run's JSON is kept in "
+                "OUT/results/: what the decision could have answered, pair by pair");
   return {sub, [o] { return runEval(*o); }};
 }
 

@@ -143,6 +143,9 @@ void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
                        "gravity estimate): not estimated then, and the map levelled by it")
         ->expected(3)
         ->delimiter(',');
+  sub.add_flag("--candidates", o.params.candidates,
+               "list every pose the searches proposed, refined and scored on the occupancy, with its error "
+               "where ground truth is given (diagnostics: every search runs)");
   sub.add_flag("--exhaustive", o.params.exhaustive,
                "match every slice pair instead of the height offsets the descriptor index points to "
                "(same answers, n^2 cost; for checking)");

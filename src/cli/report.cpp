@@ -35,12 +35,15 @@ Points sourceSample(const Points& source) {
 }
 
 GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const GroundTruth& truth, double grid) {
+  return checkAgainstGroundTruth(r.matrix(), truth, grid);
+}
+
+GroundTruthCheck checkAgainstGroundTruth(const Eigen::Matrix4d& estimate, const GroundTruth& truth, double grid) {
   GroundTruthCheck c;
   const Eigen::Matrix4d expected = truth.P_target * truth.P_source.inverse();
   c.expected = expected;
   // Whole matrices: with a levelled map the answer is no longer 4-DoF, and the
   // rotation error is then the full angle between the two rotations.
-  const Eigen::Matrix4d estimate = r.matrix();
   const Eigen::Matrix4d miss = estimate - expected;  // (E - G) p: how far E puts p from where G does
   c.at_origin = miss.topRightCorner<3, 1>().norm();
   double squares = 0;
@@ -185,16 +188,85 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
   return j;
 }
 
+namespace {
+
+/// Each candidate's check against the ground truth, where there is one.
+std::vector<std::optional<GroundTruthCheck>> candidateChecks(const MatchResult& r,
+                                                             const std::optional<GroundTruth>& truth, double grid) {
+  std::vector<std::optional<GroundTruthCheck>> out(r.candidates.size());
+  if (truth)
+    for (size_t i = 0; i < out.size(); ++i) out[i] = checkAgainstGroundTruth(r.candidate_matrices[i], *truth, grid);
+  return out;
+}
+
+nlohmann::json landedJson(const DensePose& p) {
+  return {{"x", p.transform.t.x()},
+          {"y", p.transform.t.y()},
+          {"yaw", p.transform.yaw},
+          {"height_offset_slices", p.offset},
+          {"score", p.score()},
+          {"telling_cells", p.telling_inliers},
+          {"contradicted_cells", p.contradicted},
+          {"slices", p.support},
+          {"slices_seen", p.support_seen}};
+}
+
+nlohmann::json candidatesJson(const MatchResult& r, const std::vector<std::optional<GroundTruthCheck>>& checks) {
+  nlohmann::json out = nlohmann::json::array();
+  for (size_t i = 0; i < r.candidates.size(); ++i) {
+    const Candidate& c = r.candidates[i];
+    nlohmann::json j{{"from", fromName(c.from)},
+                     {"rank", c.rank},
+                     {"feature_support", c.feature_support},
+                     {"proposed", landedJson(c.proposed_landed)},
+                     {"refined", landedJson(c.landed)}};
+    if (checks[i])
+      j["error"] = {{"translation", checks[i]->error.translation},
+                    {"yaw", checks[i]->error.yaw},
+                    {"success", checks[i]->success()}};
+    out.push_back(j);
+  }
+  return out;
+}
+
+/// The candidates, best refined score first: where each came from, its score
+/// as proposed and refined, and its error where the truth is known.
+void printCandidates(std::ostream& out, const MatchResult& r,
+                     const std::vector<std::optional<GroundTruthCheck>>& checks) {
+  std::vector<size_t> order(r.candidates.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return r.candidates[a].landed.score() > r.candidates[b].landed.score();
+  });
+  out << "candidates       " << r.candidates.size()
+      << ", best refined score first: from (rank), score proposed -> refined, slices (where the target saw "
+         "anything), contradicted cells\n";
+  for (size_t i : order) {
+    const Candidate& c = r.candidates[i];
+    out << format("  %-15s (%d) %9.0f -> %9.0f  %3d (%3d)  %6zu", fromName(c.from), c.rank,
+                  c.proposed_landed.score(), c.landed.score(), c.landed.support, c.landed.support_seen,
+                  c.landed.contradicted);
+    if (checks[i])
+      out << format("  error %.3f m, %.4f rad: %s", checks[i]->error.translation, checks[i]->error.yaw,
+                    checks[i]->success() ? "right" : "wrong");
+    out << "\n";
+  }
+}
+
+}  // namespace
+
 int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double grid, const ReportOptions& how,
            const nlohmann::json& extra) {
   std::optional<GroundTruthCheck> gt;
   if (truth) gt = checkAgainstGroundTruth(r, *truth, grid);
+  const std::vector<std::optional<GroundTruthCheck>> checks = candidateChecks(r, truth, grid);
   const bool json_to_stdout = how.json == "-";
   std::ostream& text = json_to_stdout ? std::cerr : std::cout;
   if (how.quiet)
     text << resultLine(r) << "\n";
   else
     printResult(text, r, gt, how.method);
+  if (!how.quiet && !r.candidates.empty()) printCandidates(text, r, checks);
   if (!how.json.empty()) {
     auto j = toJson(r, gt);
     j["schema_version"] = kJsonSchemaVersion;
@@ -202,6 +274,7 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
     j["method"] = how.method;
     j["grid"] = grid;
     if (extra.is_object()) j.update(extra);
+    if (!r.candidates.empty()) j["candidates"] = candidatesJson(r, checks);
     if (json_to_stdout) {
       std::cout << j.dump(2) << "\n";
     } else {

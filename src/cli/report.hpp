@@ -37,6 +37,7 @@ struct GroundTruthCheck {
 };
 
 GroundTruthCheck checkAgainstGroundTruth(const MatchResult& r, const GroundTruth& truth, double grid);
+GroundTruthCheck checkAgainstGroundTruth(const Eigen::Matrix4d& estimate, const GroundTruth& truth, double grid);
 
 /// `method` names what found `r`: "fpfh-ransac" prints keypoints instead of slices.
 void printResult(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& gt,

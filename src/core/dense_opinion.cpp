@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 
+#include "gravity.hpp"
+
 #include "dense_refine.hpp"
 #include "dense_search.hpp"
 #include "height_offsets.hpp"
@@ -171,12 +173,46 @@ void takeOccupancyHeight(MatchResult& r, const MapFeatures& target, const MapFea
   r.T_target_source.z = heightShift(target, source, r.height_offset);
 }
 
+/// Every search run, and every pose proposed (the features' distinct answers,
+/// each search's four best) refined and landed into r.candidates
+/// (MatchParams::candidates).
+void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Proposal>& feature,
+                   const MapFeatures& target, const MapFeatures& source, const MatchParams& params) {
+  std::vector<Proposal> proposals;
+  if (feature) proposals.push_back(*feature);
+  for (const Proposal& p : e.feature_rivals) proposals.push_back(p);
+  const SliceStack ft = fullSlices(target.occupancy), fs = fullSlices(source.occupancy);
+  const auto add = [&](const Opinion& o, Candidate::From from) {
+    for (size_t i = 0; i < o.search.poses.size() && i < 4; ++i)
+      proposals.push_back({from, static_cast<int>(i), 0, o.search.poses[i].transform, o.search.poses[i].offset});
+  };
+  if (denseSearchable(target.occupancy) && denseSearchable(source.occupancy)) {
+    add(searchAt(target, source, ft, fs, 1, params), Candidate::From::search_at_grid);
+    add(searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch()),
+        Candidate::From::search_wide);
+    if (target.grid <= 0.1 + 1e-9) {
+      const SliceStack pt = pooled(ft), ps = pooled(fs);
+      add(searchAt(target, source, pt, ps, 2, params), Candidate::From::search_pooled);
+    }
+  }
+  r.candidates = refineAndLand(target, source, proposals, params);
+  for (const Candidate& c : r.candidates) {
+    const Pose4 p{c.landed.transform.t.x(), c.landed.transform.t.y(), heightShift(target, source, c.landed.offset),
+                  c.landed.transform.yaw};
+    r.candidate_matrices.push_back(betweenOwnFrames(p.matrix(), target.slicedUp(), source.slicedUp()));
+  }
+}
+
 }  // namespace
 
 void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const MapFeatures& source,
                  const MatchParams& params) {
   const auto t0 = std::chrono::steady_clock::now();
   const bool features = r.support > 0;  // the features proposed an answer (judged or not)
+  const std::optional<Proposal> feature =
+      features ? std::optional<Proposal>(Proposal{Candidate::From::features, 0, r.support, planar(r.T_target_source),
+                                                  r.height_offset})
+               : std::nullopt;
   std::optional<Opinion> at_grid, wide, at_pooled;
   // The searches that answer alone search the full slices alone (kFullSlice);
   // the pooled stacks are kept for the pooled pose's second look.
@@ -245,6 +281,7 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
   const bool weighed = (e.at_grid && e.at_grid->found) || (e.wide && e.wide->found);
   if (r.reliable && weighed) climbUphill(r, found, target, source, params);
   if (r.reliable) takeOccupancyHeight(r, target, source);
+  if (params.candidates) allCandidates(r, e, feature, target, source, params);
   r.timings.dense = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 

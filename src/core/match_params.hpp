@@ -38,6 +38,10 @@ struct MatchParams {
   /// occupancy (six_dof_finish.hpp): the roll and pitch two imperfectly
   /// levelled maps leave between them.
   bool finish = true;
+  /// Record every candidate pose the searches propose, refined and landed on
+  /// the occupancy (MatchResult::candidates): what the decision could have
+  /// answered. Diagnostics: every search runs, seconds more on small maps.
+  bool candidates = false;
 };
 
 /// Whether a winning answer with `support` agreeing slice pairs is weak: below

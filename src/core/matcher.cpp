@@ -55,8 +55,9 @@ Pose4 fourDofAbout(const Eigen::Matrix4d& T, const Eigen::Vector3d& c) {
 
 /// The tomographic match of two maps' feature stacks: its figures into `r`,
 /// what the verdict weighs of them into `e`.
-void matchSlices(MatchResult& r, FeatureEvidence& e, const MapFeatures& target, const MapFeatures& source,
+void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const MapFeatures& source,
                  const MatchParams& params, const Progress& progress, PairCache* cache) {
+  FeatureEvidence& e = ev.features;
   const size_t nt = target.slices.size(), ns = source.slices.size();
   if (nt < static_cast<size_t>(params.min_support) || ns < static_cast<size_t>(params.min_support)) {
     e.missing = "too few descriptive slices (target " + std::to_string(nt) + ", source " + std::to_string(ns) +
@@ -95,6 +96,13 @@ void matchSlices(MatchResult& r, FeatureEvidence& e, const MapFeatures& target, 
     }
   r.support = static_cast<int>(best.consensus.support());
   r.height_offset = best.offset;
+  if (params.candidates) {
+    int rank = 0;
+    for (const OffsetScore& a : distinctAnswers(pairs, target, source, params))
+      if (!sameAnswer(a, best, params, source.centre()))
+        ev.feature_rivals.push_back({Candidate::From::feature_rival, ++rank, static_cast<int>(a.consensus.support()),
+                            a.consensus.mean, a.offset});
+  }
   for (size_t k : best.consensus.supporters)
     r.supporters.push_back({target.slices[k / ns].index, source.slices[k % ns].index, pairs.estimates[k].inliers});
   std::stable_sort(r.supporters.begin(), r.supporters.end(),
@@ -201,7 +209,7 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
     if (std::abs(target.grid - source.grid) > 1e-9)
       throw InputError("feature sets use different grid sizes (" + std::to_string(target.grid) + " and " +
                        std::to_string(source.grid) + " m)");
-    matchSlices(r, e.features, target, source, params, progress, cache);
+    matchSlices(r, e, target, source, params, progress, cache);
   }
   settleMatch(r, e, target, source, params);
   Eigen::Matrix4d answer = r.T_target_source.matrix();  // between the levelled frames

@@ -3,6 +3,7 @@
 #include <optional>
 #include <string>
 
+#include "candidates.hpp"
 #include "match_params.hpp"
 #include "rigid2d.hpp"
 #include "six_dof_finish.hpp"
@@ -90,6 +91,11 @@ struct MatchResult {
   size_t slice_pairs_total = 0;     ///< n_target x n_source slices with features
   size_t slice_pairs_recalled = 0;  ///< of slice_pairs, those a PairCache remembered instead of matched
   StageTimings timings;
+  /// With MatchParams::candidates: every candidate pose the searches
+  /// proposed, refined and landed (candidates.hpp), and each one's whole
+  /// transform between the maps' own frames (as matrix() gives the answer's).
+  std::vector<Candidate> candidates;
+  std::vector<Eigen::Matrix4d> candidate_matrices;
 };
 
 /// Finds T_target_source from two feature stacks of the same grid size: slice

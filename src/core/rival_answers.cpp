@@ -20,11 +20,8 @@ bool sameAnswer(const OffsetScore& a, const OffsetScore& b, const MatchParams& p
          agree(a.consensus.mean, b.consensus.mean, consensusParams(params, params.grid), centre);
 }
 
-std::optional<LandedChoice> chooseByLanding(const SlicePairTable& table, const MapFeatures& target,
-                                            const MapFeatures& source, const MatchParams& params) {
-  // Where the dense search would run: on a street at g 0.1 (not searchable)
-  // the landings cost 90-160 MB and 0.2-0.3 s a match, for answers that were right.
-  if (!denseSearchable(target.occupancy) || !denseSearchable(source.occupancy)) return std::nullopt;
+std::vector<OffsetScore> distinctAnswers(const SlicePairTable& table, const MapFeatures& target,
+                                         const MapFeatures& source, const MatchParams& params) {
   std::vector<OffsetScore> groups = scoreOffsets(table, target, source, params, kGroupsPerOffset);
   std::stable_sort(groups.begin(), groups.end(), outranks);
   std::vector<OffsetScore> answers;
@@ -34,6 +31,15 @@ std::optional<LandedChoice> chooseByLanding(const SlicePairTable& table, const M
                                   [&](const OffsetScore& a) { return sameAnswer(a, g, params, source.centre()); });
     if (!seen) answers.push_back(std::move(g));
   }
+  return answers;
+}
+
+std::optional<LandedChoice> chooseByLanding(const SlicePairTable& table, const MapFeatures& target,
+                                            const MapFeatures& source, const MatchParams& params) {
+  // Where the dense search would run: on a street at g 0.1 (not searchable)
+  // the landings cost 90-160 MB and 0.2-0.3 s a match, for answers that were right.
+  if (!denseSearchable(target.occupancy) || !denseSearchable(source.occupancy)) return std::nullopt;
+  const std::vector<OffsetScore> answers = distinctAnswers(table, target, source, params);
   if (answers.size() < 2) return std::nullopt;
 
   std::vector<std::pair<Rigid2D, int>> poses;

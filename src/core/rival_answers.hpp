@@ -19,6 +19,12 @@ bool sameAnswer(const OffsetScore& a, const OffsetScore& b, const MatchParams& p
 
 /// The features' distinct answers (every height offset's consensus groups;
 /// those within the smear of offsets with the same transform are one), the
+/// kMostRivals with most support, most first.
+std::vector<OffsetScore> distinctAnswers(const SlicePairTable& table, const MapFeatures& target,
+                                         const MapFeatures& source, const MatchParams& params);
+
+/// The features' distinct answers (every height offset's consensus groups;
+/// those within the smear of offsets with the same transform are one), the
 /// kMostRivals with most support, landed on both maps' occupancy as the dense
 /// search lands its poses (dense_search.hpp). The answer whose landing holds
 /// (verdict.hpp) and outscores every other beyond chance (kSignificant),

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "candidates.hpp"
 #include "dense_search.hpp"
 #include "match_params.hpp"
 
@@ -103,6 +104,8 @@ struct Evidence {
   /// The best pose around the features' answer, beyond one consensus
   /// tolerance and within kAroundTolerances of it (nearby_poses.hpp).
   std::optional<DensePose> around_features;
+  /// The features' distinct answers after the winner (rival_answers.hpp), as proposals.
+  std::vector<Proposal> feature_rivals;
 };
 
 struct Verdict {

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <regex>
+#include <set>
 
 #include "results/json_schema.hpp"
 #include "support.hpp"
@@ -281,6 +282,38 @@ TEST(Cli, PaperConsensusBaselineAnswersWithoutAVerdict) {
   expectBadInput(test::runBinary(TOMOMAP_BASELINE_BIN, "--method icp " + pair), "--method");
 }
 
+// --candidates lists what the decision could have answered: on a small room
+// the features' answer and every dense search's best poses, each refined and
+// scored on the occupancy, and with ground truth which of them are right.
+TEST(Cli, CandidatesListEveryProposedPoseScoredWithItsError) {
+  TempDir dir;
+  const std::string w = dir / "room";
+  ASSERT_EQ(runTomomap("synth --world room --seed 1 --noise low --out " + w).exit_code, 0);
+  const auto r = runTomomap("match " + w + "/map_0.pcd " + w + "/map_1.pcd --grid 0.1 --gt-target " + w +
+                            "/map_0-gtpose.txt --gt-source " + w + "/map_1-gtpose.txt --candidates --json " +
+                            (dir / "c.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("candidates       "), std::string::npos) << r.output;
+  const auto j = nlohmann::json::parse(std::ifstream(dir / "c.json"));
+  ASSERT_TRUE(j.contains("candidates")) << j.dump();
+  std::set<std::string> from;
+  double best_score = -1e18;
+  bool best_right = false;
+  for (const auto& c : j["candidates"]) {
+    from.insert(c["from"].get<std::string>());
+    EXPECT_GE(c["refined"]["score"].get<double>(), c["proposed"]["score"].get<double>()) << "a climb only goes up";
+    if (c["refined"]["score"].get<double>() > best_score) {
+      best_score = c["refined"]["score"].get<double>();
+      best_right = c["error"]["success"].get<bool>();
+    }
+  }
+  for (const char* search : {"features", "search_at_grid", "search_wide", "search_pooled"})
+    EXPECT_TRUE(from.count(search)) << search << " proposed nothing\n" << r.output;
+  EXPECT_TRUE(best_right) << "on this room the best-scoring candidate is the right pose\n" << r.output;
+  const auto plain = runTomomap("match " + w + "/map_0.pcd " + w + "/map_1.pcd --grid 0.1 --json " + (dir / "p.json"));
+  EXPECT_FALSE(nlohmann::json::parse(std::ifstream(dir / "p.json")).contains("candidates")) << "only when asked";
+}
+
 namespace {
 
 /// Pixels of exactly this BGR colour.
@@ -464,5 +497,6 @@ TEST(Cli, TheJsonOutputIsTheDocumentedContract) {
   ASSERT_FALSE(documented.empty());
   for (const auto& k : written) EXPECT_TRUE(documented.count(k)) << k << " is written but not in docs/json.md";
   documented.erase("T_target_source_6dof");  // only with --level
+  documented.erase("candidates");            // only with --candidates
   for (const auto& k : documented) EXPECT_TRUE(written.count(k)) << k << " is in docs/json.md but not written";
 }

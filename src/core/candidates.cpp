@@ -1,0 +1,75 @@
+#include "candidates.hpp"
+
+#include <algorithm>
+
+#include "height_offsets.hpp"
+#include "nearby_poses.hpp"
+#include "verdict.hpp"
+
+namespace tomomap {
+namespace {
+
+/// Places climbed at most: each climb lands thousands of poses.
+constexpr size_t kMostClimbs = 4;
+
+}  // namespace
+
+const char* fromName(Candidate::From from) {
+  switch (from) {
+    case Candidate::From::features:
+      return "features";
+    case Candidate::From::feature_rival:
+      return "feature_rival";
+    case Candidate::From::search_at_grid:
+      return "search_at_grid";
+    case Candidate::From::search_wide:
+      return "search_wide";
+    case Candidate::From::search_pooled:
+      return "search_pooled";
+  }
+  return "?";
+}
+
+std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeatures& source,
+                                     const std::vector<Proposal>& proposals, const MatchParams& params) {
+  if (target.occupancy.partial || source.occupancy.partial || proposals.empty()) return {};
+  DenseSearchParams dp;
+  dp.threads = matchThreads(params);
+  const PoseLander land = poseLander(target.occupancy, source.occupancy, dp);
+  std::vector<std::pair<Rigid2D, int>> poses;
+  for (const Proposal& p : proposals) poses.emplace_back(p.T, p.offset);
+  const std::vector<DensePose> as_proposed = land(poses);
+  if (as_proposed.size() != proposals.size()) return {};
+  std::vector<Candidate> out;
+  for (size_t i = 0; i < proposals.size(); ++i) {
+    const Proposal& p = proposals[i];
+    out.push_back({p.from, p.rank, p.feature_support, p.T, p.offset, as_proposed[i], as_proposed[i]});
+  }
+  // The best distinct places as proposed climb (small maps: on a large one
+  // a climb takes seconds); two proposals are one place within looksApart
+  // at the source's centre and the smear of heights.
+  if (!denseSearchable(target.occupancy) || !denseSearchable(source.occupancy)) return out;
+  std::vector<size_t> order(out.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return out[a].proposed_landed.score() > out[b].proposed_landed.score();
+  });
+  ConsensusParams same = consensusParams(params, target.grid);
+  same.translation_tolerance = looksApart(params, target.grid);
+  const Eigen::Vector2d centre = source.occupancy.grid.centre();
+  std::vector<size_t> climbed;
+  for (size_t i : order) {
+    if (climbed.size() == kMostClimbs) break;
+    Candidate& c = out[i];
+    const bool seen = std::any_of(climbed.begin(), climbed.end(), [&](size_t k) {
+      return std::abs(out[k].proposed_offset - c.proposed_offset) <= kSmearSlices / 2 &&
+             agree(out[k].proposed, c.proposed, same, centre);
+    });
+    if (seen) continue;
+    climbed.push_back(i);
+    c.landed = uphill(land, target.occupancy, source.occupancy, c.proposed, c.proposed_offset, dp);
+  }
+  return out;
+}
+
+}  // namespace tomomap

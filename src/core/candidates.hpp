@@ -1,0 +1,42 @@
+#pragma once
+// Candidate poses: what every search proposes, each refined and scored the
+// same way on the two maps' occupancy (docs/algorithm.md, "The decision").
+#include <vector>
+
+#include "dense_search.hpp"
+#include "features.hpp"
+#include "match_params.hpp"
+
+namespace tomomap {
+
+/// One pose a search proposed, refined on the occupancy and landed there.
+struct Candidate {
+  enum class From { features, feature_rival, search_at_grid, search_wide, search_pooled };
+  From from = From::features;
+  int rank = 0;             ///< its rank among its search's proposals (0: that search's best)
+  int feature_support = 0;  ///< agreeing slice pairs behind it (from features only)
+  Rigid2D proposed;         ///< as its search proposed it
+  int proposed_offset = 0;  ///< [slices]
+  DensePose proposed_landed;  ///< the proposal landed as it is
+  DensePose landed;           ///< refined (uphill, where it climbed) and landed
+};
+
+const char* fromName(Candidate::From from);
+
+/// A proposal: a pose, its height offset, where it came from.
+struct Proposal {
+  Candidate::From from = Candidate::From::features;
+  int rank = 0;
+  int feature_support = 0;
+  Rigid2D T;
+  int offset = 0;
+};
+
+/// Every proposal landed on the maps' occupancy as the dense search lands its
+/// poses (dense_search.hpp); on maps small enough for that search, the
+/// kMostClimbs best distinct places climb uphill (nearby_poses.hpp), the rest
+/// stay as proposed. Empty where either map's occupancy is partial.
+std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeatures& source,
+                                     const std::vector<Proposal>& proposals, const MatchParams& params);
+
+}  // namespace tomomap
