@@ -220,6 +220,10 @@ nlohmann::json candidatesJson(const MatchResult& r, const std::vector<std::optio
                      {"feature_support", c.feature_support},
                      {"proposed", landedJson(c.proposed_landed)},
                      {"refined", landedJson(c.landed)}};
+    nlohmann::json slices = nlohmann::json::array();
+    for (const SliceLanding& s : c.slices)
+      if (s.cells > 0) slices.push_back({s.slice, s.cells, s.telling, s.seen, s.on, s.telling_on, s.contradicted});
+    j["slices"] = slices;
     if (checks[i])
       j["error"] = {{"translation", checks[i]->error.translation},
                     {"yaw", checks[i]->error.yaw},

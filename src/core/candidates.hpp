@@ -19,6 +19,7 @@ struct Candidate {
   int proposed_offset = 0;  ///< [slices]
   DensePose proposed_landed;  ///< the proposal landed as it is
   DensePose landed;           ///< refined (uphill, where it climbed) and landed
+  std::vector<SliceLanding> slices;  ///< `landed`, source slice by source slice
 };
 
 const char* fromName(Candidate::From from);

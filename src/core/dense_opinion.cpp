@@ -153,7 +153,7 @@ void climbUphill(MatchResult& r, const std::vector<std::pair<Rigid2D, int>>& fou
   if (landed.empty()) return;
   const DensePose* start = &landed.front();
   for (const DensePose& p : landed)
-    if (p.score() > start->score() && significance(p.score(), landed.front().score()) >= kSignificant) start = &p;
+    if (p.score() > start->score() && significance(p.score(), landed.front().score()) >= kBars.significant) start = &p;
   const DensePose top = uphill(land, target.occupancy, source.occupancy, start->transform, start->offset, dp);
   r.T_target_source = {top.transform.t.x(), top.transform.t.y(), heightShift(target, source, top.offset),
                        wrapAngle(top.transform.yaw)};
@@ -258,7 +258,7 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
         DenseSearchParams dp;
         dp.threads = matchThreads(params);
         e.around_features = bestAround(target.occupancy, source.occupancy, planar(r.T_target_source), r.height_offset,
-                                       tolerance, kAroundTolerances * tolerance, dp);
+                                       tolerance, kBars.around_tolerances * tolerance, dp);
         break;
       }
       case Verdict::Needs::nothing:

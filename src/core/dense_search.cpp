@@ -134,24 +134,37 @@ struct Tally {
 };
 
 Tally countInliers(const std::vector<cv::Mat>& dilated, const std::vector<Cell>& cells, const std::vector<int>& landing,
-                   int offset, int source_slices, const Enclosure* enclosure = nullptr, const cv::Mat* seen = nullptr) {
+                   int offset, int source_slices, const Enclosure* enclosure = nullptr, const cv::Mat* seen = nullptr,
+                   std::vector<SliceLanding>* per_slice = nullptr) {
   Tally t;
   std::vector<size_t> on(static_cast<size_t>(source_slices), 0), all(on), all_seen(on);
+  if (per_slice) {
+    per_slice->assign(static_cast<size_t>(source_slices), SliceLanding{});
+    for (int k = 0; k < source_slices; ++k) (*per_slice)[static_cast<size_t>(k)].slice = k;
+  }
   for (size_t n = 0; n < cells.size(); ++n) {
     const Cell& c = cells[n];
+    SliceLanding* s = per_slice ? &(*per_slice)[static_cast<size_t>(c.slice)] : nullptr;
+    if (s) ++s->cells, s->telling += c.telling;
     const int i = c.slice + offset;
     if (i < 0 || i >= static_cast<int>(dilated.size()) || dilated[static_cast<size_t>(i)].empty()) continue;
     ++all[static_cast<size_t>(c.slice)];
     // Dilated images are continuous: pixel index = element index.
     if (landing[n] < 0) continue;
-    if (seen && seen->ptr<uint8_t>()[landing[n]]) ++all_seen[static_cast<size_t>(c.slice)];
+    if (seen && seen->ptr<uint8_t>()[landing[n]]) {
+      ++all_seen[static_cast<size_t>(c.slice)];
+      if (s) ++s->seen;
+    }
     if (!dilated[static_cast<size_t>(i)].ptr<uint8_t>()[landing[n]]) {
-      t.contradicted += c.telling && enclosure && enclosure->encloses(landing[n], i);
+      const bool against = c.telling && enclosure && enclosure->encloses(landing[n], i);
+      t.contradicted += against;
+      if (s) s->contradicted += against;
       continue;
     }
     ++t.inliers;
     t.telling += c.telling;
     ++on[static_cast<size_t>(c.slice)];
+    if (s) ++s->on, s->telling_on += c.telling;
   }
   for (size_t k = 0; k < on.size(); ++k) {
     t.slices += all[k] > 0 && 2 * on[k] >= all[k];
@@ -221,6 +234,18 @@ struct PoseJudge {
 };
 
 }  // namespace
+
+std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, const SliceStack& source,
+                                                  const std::vector<std::pair<Rigid2D, int>>& poses,
+                                                  const DenseSearchParams& params) {
+  if (target.partial || source.partial) return {};
+  const PoseJudge judge(target, source, params);
+  std::vector<std::vector<SliceLanding>> out(poses.size());
+  for (size_t n = 0; n < poses.size(); ++n)
+    countInliers(judge.dilated, judge.source_cells, landings(judge.source_cells, poses[n].first, target.grid),
+                 poses[n].second, source.size(), judge.in_target, &judge.target_seen, &out[n]);
+  return out;
+}
 
 PoseLander poseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params) {
   if (target.partial || source.partial) return [](const auto&) { return std::vector<DensePose>{}; };

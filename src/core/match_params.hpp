@@ -44,16 +44,6 @@ struct MatchParams {
   bool candidates = false;
 };
 
-/// Whether a winning answer with `support` agreeing slice pairs is weak: below
-/// five times min_support, its lead over another answer is judged by an
-/// absolute margin (another answer within min_support pairs, verdict.cpp)
-/// rather than by a share of its support; the indexed search follows rivals
-/// by that margin (offset_search.cpp), and on small maps the dense search
-/// checks every answer whose lead over its runner-up is weak by this measure
-/// (rooms came out reliable and wrong at 7 slice pairs against 3 and at 15
-/// against 5; verdict.cpp).
-inline bool weakWinner(int support, const MatchParams& params) { return support < 5 * params.min_support; }
-
 /// Called with (stage name, done, total) as work advances; may be empty.
 using Progress = std::function<void(const char*, size_t, size_t)>;
 

@@ -27,7 +27,7 @@ std::vector<OffsetScore> distinctAnswers(const SlicePairTable& table, const MapF
 /// those within the smear of offsets with the same transform are one), the
 /// kMostRivals with most support, landed on both maps' occupancy as the dense
 /// search lands its poses (dense_search.hpp). The answer whose landing holds
-/// (verdict.hpp) and outscores every other beyond chance (kSignificant),
+/// (verdict.hpp) and outscores every other beyond chance (kBars.significant),
 /// if there is one. Where a building's rooms repeat along it, slice pairs
 /// support a copy a room along as well as the right pose, often more; the copy
 /// lands on walls where the other map saw empty space. Nothing where either

@@ -18,15 +18,16 @@ struct SixDofFinishParams {
   /// an update moves the cells less than `converged_cells`.
   int iterations_per_stage = 15;
   /// An update that moves the cells less than this is converged [grid cells]: far
-  /// below the quantisation of the cells themselves. At 0.001 cells the stages
-  /// ran to their 15 iterations on the generated buildings at 0.05 m (the
-  /// correspondences keep flipping by a cell); at 0.02 the SLAM maps' answers
-  /// (hku-main-building, 16 leaning pairs) moved at most 4 mm and 0.03 deg, and
-  /// the finish took 0.22 s instead of 0.34 (median, docs/results.md).
+  /// below the quantisation of the cells themselves. At 0.001 the stages ran
+  /// to their 15 iterations on the generated buildings at 0.05 m (the
+  /// correspondences keep flipping by a cell).
   double converged_cells = 0.02;
   /// Source cells used at most (evenly thinned) [count]: bounds the time;
-  /// twenty thousand surface cells fix six parameters many times over (at
-  /// 40,000 the same pairs' answers moved by at most 5 mm more).
+  /// twenty thousand surface cells fix six parameters many times over. Against
+  /// 0.001 cells and 40,000: the SLAM maps' errors (hku-main-building, 16
+  /// leaning pairs) changed by at most 4 mm and 0.04 deg, the generated
+  /// buildings' and tilted maps' by at most 11 mm (streets' 17-30 mm smaller),
+  /// and the finish took 0.13 s instead of 0.34 (median of those 24 pairs).
   size_t max_points = 20000;
   /// Target normals: principal axes of the target cells within this radius
   /// [grid cells]; 2 cells hold ~13 cells of a plane, enough for a stable normal.

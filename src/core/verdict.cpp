@@ -8,47 +8,11 @@
 namespace tomomap {
 namespace {
 
-/// A feature winner must have this many times its runner-up's support (as
-/// well as min_support slice pairs more): on small rooms a wrong transform,
-/// repeated over a few similar slices, won 3-5 to 2-4 against another wrong
-/// one, while right matches (synth indoor and outdoor, seeds 1-4 at every
-/// noise level, demo-room both ways at g 0.05-0.15) led by 4 or more; and two
-/// identical floors gave 30 vs 29.
-constexpr double kClearAhead = 1.25;
-/// The dense search's winner must score this many times its best other
-/// pose to answer alone. Room pairs (synth -w room, seeds 1-10, every noise,
-/// g 0.1 and 0.05), ranked by telling cells alone: wrong winners led by
-/// 1.00-1.33, right ones by 1.04-3.37; 38 of the 54 right ones lead by 1.4 or
-/// more. With empty space read (seeds 1-100, low and high noise, g 0.1; and
-/// pooled from g 0.05), wrong winners led by at most 1.14.
-constexpr double kDenseLead = 1.4;
-/// A feature answer on a small map stands only where the dense search's best
-/// pose is this far ahead of its next (with `min_support` slices) and is the
-/// same pose; a best pose that far ahead elsewhere refuses it (or, at
-/// kDenseLead, replaces it), and so does one too close to its next to tell.
-/// Of 820 room pairs (seeds 1-200 at low and high noise, 1-10 noise-free;
-/// g 0.1 and 0.05) the features answered 33, 10 of them wrong: the dense
-/// search confirmed none of the 10 (its best pose elsewhere, or at most 1.08x
-/// ahead) and 17 of the 23 right ones (1.22x and more).
-constexpr double kDenseOpinion = 1.2;
-/// A wide best pose confirms a thin feature answer over this many slices (of
-/// those landing where the other map saw anything), not min_support: the two
-/// searches, one on descriptors and one on occupancy, each find the pose on
-/// their own, and more than one slice means more than a floor or the ground.
-/// At min_support the matrix's kitti-lidar-16 (features on 2 slice pairs, the
-/// wide search's best pose theirs, 2.05x ahead, over 2 slices) was refused,
-/// which the paper's method answers right; at 2 it is answered, 0.07 m off,
-/// and nothing else changed on the matrix, real-scan seeds 1-300 and rooms
-/// seeds 1-100 (1,878 pairs).
-constexpr int kConfirmingSlices = 2;
-/// Pooled occupancy is searched only where its cell stays this fine [m]
-/// (maps at g 0.1 and finer): room pairs were measured up to there.
-constexpr double kCoarsestPooledCell = 0.2;
 
 /// Whether another feature answer has almost as much support as the winner.
 bool ambiguous(const FeatureEvidence& f, const MatchParams& params) {
   return f.runner_up_support > 0 && (f.support - f.runner_up_support < params.min_support ||
-                                     static_cast<double>(f.support) < kClearAhead * f.runner_up_support);
+                                     static_cast<double>(f.support) < kBars.clear_ahead * f.runner_up_support);
 }
 
 /// Why the features' answer is no reliable match on its own; empty if it is one.
@@ -71,7 +35,7 @@ double leadOver(double score, double other) { return score <= 0 ? 0 : score / st
 
 /// Whether a pose's score leads `other` by `by`, beyond chance.
 bool aheadBeyondChance(double score, double other, double by) {
-  return leadOver(score, other) >= by && significance(score, other) >= kSignificant;
+  return leadOver(score, other) >= by && significance(score, other) >= kBars.significant;
 }
 
 /// Whether a search found a best pose that leads its next by `by`, beyond chance.
@@ -99,9 +63,9 @@ bool thinFeatureAnswer(const FeatureEvidence& f, const MatchParams& params) {
 }
 
 /// Whether a search's best pose confirms a thin feature answer it lands on:
-/// a confirmation's lead, beyond chance, holding where seen over kConfirmingSlices.
+/// a confirmation's lead, beyond chance, holding where seen over kBars.confirming_slices.
 bool confirmsThin(const DenseEvidence& d) {
-  return d.at_features && aheadBeyondChance(d, kDenseOpinion) && holdsWhereSeen(d.best, kConfirmingSlices);
+  return d.at_features && aheadBeyondChance(d, kBars.dense_opinion) && holdsWhereSeen(d.best, kBars.confirming_slices);
 }
 
 /// Whether a pose found otherwise (the features' answer, landed) lands more
@@ -119,7 +83,7 @@ std::string shortfall(const DenseEvidence& d, double by, int slices, int need) {
   std::string out = "lead " + fixed(d.lead(), 2) + "x";
   if (d.lead() < by) out += ", need " + fixed(by, 2) + "x";
   const double sigma = significance(d.best.score(), d.next_score);
-  if (sigma < kSignificant) out += "; " + fixed(sigma, 1) + " sigma beyond chance, need " + fixed(kSignificant, 0);
+  if (sigma < kBars.significant) out += "; " + fixed(sigma, 1) + " sigma beyond chance, need " + fixed(kBars.significant, 0);
   if (slices < need) out += "; over " + std::to_string(slices) + " slices, need " + std::to_string(need);
   return out;
 }
@@ -132,7 +96,7 @@ std::string contradictionNote(const DenseEvidence& d) {
   if (!d.found || consistent(d.best)) return "";
   return "; it lands " + fixed(100 * contradiction(d.best), 0) +
          " % as many telling cells in space the other map saw empty as on its occupancy (at most " +
-         fixed(100 * kMostContradicted, 0) + " %)";
+         fixed(100 * kBars.most_contradicted, 0) + " %)";
 }
 
 /// How a pose found otherwise measures against outscoring a pose that scores
@@ -154,7 +118,7 @@ std::string howFarApart(const DenseEvidence& d) {
 std::string unconfirmed(const DenseEvidence& d) {
   const std::string what = "; a search on a raster twice as fine did not confirm it (";
   if (!d.at_features) return what + "its best pose lies " + howFarApart(d) + ")";
-  return what + shortfall(d, kDenseOpinion, d.best.support_seen, kConfirmingSlices) + ")" + contradictionNote(d);
+  return what + shortfall(d, kBars.dense_opinion, d.best.support_seen, kBars.confirming_slices) + ")" + contradictionNote(d);
 }
 
 Verdict by(Verdict::By b) { return {b, "", Verdict::Needs::nothing}; }
@@ -193,7 +157,7 @@ double contradiction(const DensePose& p) {
   return static_cast<double>(p.contradicted) / static_cast<double>(std::max<size_t>(p.telling_inliers, 1));
 }
 
-bool consistent(const DensePose& p) { return contradiction(p) <= kMostContradicted; }
+bool consistent(const DensePose& p) { return contradiction(p) <= kBars.most_contradicted; }
 
 bool holdsOver(const DensePose& p, int min_support) { return consistent(p) && p.support >= min_support; }
 
@@ -236,22 +200,22 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
     // the pose the features found: on kitti crops (seeds 1-300) it ranked a
     // pose elsewhere first where the features' right pose landed 1.7-2.8
     // times as much. That pose answers as the search's own best would
-    // (kDenseLead ahead, beyond chance, over min_support slices), where the
+    // (kBars.dense_lead ahead, beyond chance, over min_support slices), where the
     // occupancy pins it down: no pose around it lands as much within chance.
     if (e.wide->found && !e.wide->at_features) {
       if (!e.features_landed) return needs(Verdict::Needs::features_landed);
       const DensePose& landed = *e.features_landed;
-      if (outscores(landed, e.wide->best.score(), kDenseLead, params)) {
+      if (outscores(landed, e.wide->best.score(), kBars.dense_lead, params)) {
         if (!e.around_features) return needs(Verdict::Needs::around_features);
         const DensePose& near = *e.around_features;
         if (outscores(landed, near.score(), 1, params)) return by(Verdict::By::features);
         why += "; the features' pose lands " + fixed(landed.score(), 0) + " telling cells, one " +
                fixed((near.transform.t - landed.transform.t).norm(), 2) + " m from it " + fixed(near.score(), 0) +
                " (" + fixed(significance(landed.score(), near.score()), 1) + " sigma beyond chance, need " +
-               fixed(kSignificant, 0) + "): the occupancy does not pin it down";
+               fixed(kBars.significant, 0) + "): the occupancy does not pin it down";
       } else {
         why += "; the features' pose lands " + fixed(landed.score(), 0) + " telling cells, that pose " +
-               fixed(e.wide->best.score(), 0) + " (" + outscoring(landed, e.wide->best.score(), kDenseLead, params) +
+               fixed(e.wide->best.score(), 0) + " (" + outscoring(landed, e.wide->best.score(), kBars.dense_lead, params) +
                ")";
       }
     }
@@ -259,7 +223,7 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
   if (!e.at_grid) return needs(Verdict::Needs::search_at_grid);
   const DenseEvidence& grid = *e.at_grid;
   if (!grid.found) return features ? by(Verdict::By::features) : none(why);
-  const bool clear = leads(grid, kDenseLead, params);
+  const bool clear = leads(grid, kBars.dense_lead, params);
   if (features) {
     // A search whose best pose contradicts what the other map saw empty found
     // no place of its own for the maps; the features' pose is then judged the
@@ -272,20 +236,20 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
       if (!e.features_landed) return needs(Verdict::Needs::features_landed);
       if (holdsOver(*e.features_landed, params.min_support)) return by(Verdict::By::features);
     }
-    if (grid.at_features && leads(grid, kDenseOpinion, params)) return by(Verdict::By::features);
+    if (grid.at_features && leads(grid, kBars.dense_opinion, params)) return by(Verdict::By::features);
     // A clear dense pose elsewhere replaces the features' answer, as it
     // replaces a refused one: on the 820 room pairs it did so 11 times, each
     // right (0.003-0.105 m off), where the features had led by a few pairs.
     if (clear) return preciseWhereStated(Verdict::By::at_grid, e, params);
-    if (!leads(grid, kDenseOpinion, params))
+    if (!leads(grid, kBars.dense_opinion, params))
       why = "a dense search of the occupancy does not confirm the features' answer (its best pose: " +
-            shortfall(grid, kDenseOpinion, params) + ")" + contradictionNote(grid);
+            shortfall(grid, kBars.dense_opinion, params) + ")" + contradictionNote(grid);
     else
       why = "the features and a dense search of the occupancy disagree (" + fixed(grid.lead(), 2) +
             "x lead for a pose " + howFarApart(grid) + ")";
   } else {
     if (clear) return preciseWhereStated(Verdict::By::at_grid, e, params);
-    why += "; nor did a dense search of the occupancy find a clear pose (" + shortfall(grid, kDenseLead, params) + ")" +
+    why += "; nor did a dense search of the occupancy find a clear pose (" + shortfall(grid, kBars.dense_lead, params) + ")" +
            contradictionNote(grid);
   }
 
@@ -296,7 +260,7 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
   // pose short of a clear lead: that rule answered none of 1,488 pairs (rooms
   // seeds 1-200 at g 0.05 and 0.1, the building at g 0.2, the regression
   // matrix, fresh real-scan seeds) once the wide search came before it.
-  if (2 * e.grid > kCoarsestPooledCell + 1e-9) return none(why);
+  if (2 * e.grid > kBars.coarsest_pooled_cell + 1e-9) return none(why);
   if (!e.pooled) return needs(Verdict::Needs::pooled_search);
   const DenseEvidence& pooled = *e.pooled;
   if (!pooled.found) return none(why);
@@ -307,15 +271,15 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
   // answered elsewhere, 1.62x ahead, 1.36 m off; on the rooms of seeds 1-30
   // and the RGB-D crops of seeds 1-300 no pooled answer met a grid pose
   // leading 1.4x (the most was 1.39x, at the pooled answer's place).
-  if (leads(pooled, kDenseLead, params)) {
-    if (!aheadBeyondChance(grid, kDenseLead) || pooled.at_grid_best)
+  if (leads(pooled, kBars.dense_lead, params)) {
+    if (!aheadBeyondChance(grid, kBars.dense_lead) || pooled.at_grid_best)
       return preciseWhereStated(Verdict::By::pooled, e, params);
     return none(why + "; at " + fixed(pooled.cell, 2) + " m cells its best pose leads " + fixed(pooled.lead(), 2) +
                 "x but lies elsewhere than the map's grid's best pose, " + fixed(grid.lead(), 2) + "x ahead over " +
                 std::to_string(grid.best.support) + " slices");
   }
   return none(why + "; at " + fixed(pooled.cell, 2) +
-              " m cells its best pose: " + shortfall(pooled, kDenseLead, params) + contradictionNote(pooled));
+              " m cells its best pose: " + shortfall(pooled, kBars.dense_lead, params) + contradictionNote(pooled));
 }
 
 }  // namespace tomomap

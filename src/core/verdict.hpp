@@ -12,32 +12,90 @@
 
 namespace tomomap {
 
-/// A pose that lands more than this share as many telling cells in space the
-/// other map saw empty as on its occupancy does not answer or confirm: the
-/// right best poses of room pairs (seeds 1-100, low and high noise, at 0.1 m
-/// cells) landed at most 0.18, the wrong one a held-out pair answered (seed
-/// 208, high noise, g 0.1: 2.75 m off, the right pose not among the search's
-/// candidates) 0.24.
-constexpr double kMostContradicted = 0.2;
 
-/// A lead counts only this many standard deviations beyond chance: a pose's
-/// score is a count of cells, and two counts differ by their square roots'
-/// sum by chance alone. On a real RGB-D room (sunrgbd-room-2 at g 0.1) the
-/// pooled search's best pose led 13 to 7 (1.3 sigma) and was 13.9 m off; right
-/// answers on rooms lead by tens of sigma.
-constexpr double kSignificant = 3.0;
 
-/// How far around the features' answer the occupancy is searched for a pose
-/// that lands as much, in consensus tolerances (bestAround, from one
-/// tolerance out): a thin feature answer the wide search missed stands only
-/// if none does. On a kitti crop (seed 9, g 0.2) the features' pose landed
-/// 179 telling cells and the true pose, 2.2 m (11 cells) along the street,
-/// 181; the wide search's coarse cells there are 6 grid cells.
-constexpr int kAroundTolerances = 4;
+
+/// Every bar the decision uses, each with its unit and how it was derived:
+/// the one place they are stated. (What the bars measure is defined where it
+/// is computed: a pose's score in dense_search.hpp, the smear of heights in
+/// height_offsets.hpp, the user's settings in match_params.hpp.)
+struct DecisionBars {
+  /// A pose that lands more than this share as many telling cells in space the
+  /// other map saw empty as on its occupancy does not answer or confirm: the
+  /// right best poses of room pairs (seeds 1-100, low and high noise, at 0.1 m
+  /// cells) landed at most 0.18, the wrong one a held-out pair answered (seed
+  /// 208, high noise, g 0.1: 2.75 m off, the right pose not among the search's
+  /// candidates) 0.24.
+  double most_contradicted = 0.2;  ///< [share of telling cells landed]
+  /// A lead counts only this many standard deviations beyond chance: a pose's
+  /// score is a count of cells, and two counts differ by their square roots'
+  /// sum by chance alone. On a real RGB-D room (sunrgbd-room-2 at g 0.1) the
+  /// pooled search's best pose led 13 to 7 (1.3 sigma) and was 13.9 m off; right
+  /// answers on rooms lead by tens of sigma.
+  double significant = 3.0;  ///< [standard deviations]
+  /// How far around the features' answer the occupancy is searched for a pose
+  /// that lands as much, in consensus tolerances (bestAround, from one
+  /// tolerance out): a thin feature answer the wide search missed stands only
+  /// if none does. On a kitti crop (seed 9, g 0.2) the features' pose landed
+  /// 179 telling cells and the true pose, 2.2 m (11 cells) along the street,
+  /// 181; the wide search's coarse cells there are 6 grid cells.
+  int around_tolerances = 4;  ///< [consensus tolerances]
+  /// A feature winner whose support is at least this many times min_support
+  /// ahead of its runner-up is strong: it stands alone. Below it, its lead is
+  /// judged by an absolute margin (another answer within min_support pairs)
+  /// rather than by a share of its support; the indexed search follows rivals
+  /// by that margin (offset_search.cpp), and on small maps the dense search
+  /// checks every answer whose lead is weak by this measure (rooms came out
+  /// reliable and wrong at 7 slice pairs against 3 and at 15 against 5).
+  int strong_winner = 5;  ///< [times min_support]
+  /// A feature winner must have this many times its runner-up's support (as
+  /// well as min_support slice pairs more): on small rooms a wrong transform,
+  /// repeated over a few similar slices, won 3-5 to 2-4 against another wrong
+  /// one, while right matches (synth indoor and outdoor, seeds 1-4 at every
+  /// noise level, demo-room both ways at g 0.05-0.15) led by 4 or more; and two
+  /// identical floors gave 30 vs 29.
+  double clear_ahead = 1.25;  ///< [ratio of slice pairs]
+  /// The dense search's winner must score this many times its best other
+  /// pose to answer alone. Room pairs (synth -w room, seeds 1-10, every noise,
+  /// g 0.1 and 0.05), ranked by telling cells alone: wrong winners led by
+  /// 1.00-1.33, right ones by 1.04-3.37; 38 of the 54 right ones lead by 1.4 or
+  /// more. With empty space read (seeds 1-100, low and high noise, g 0.1; and
+  /// pooled from g 0.05), wrong winners led by at most 1.14.
+  double dense_lead = 1.4;  ///< [ratio of scores]
+  /// A feature answer on a small map stands only where the dense search's best
+  /// pose is this far ahead of its next (with `min_support` slices) and is the
+  /// same pose; a best pose that far ahead elsewhere refuses it (or, at
+  /// kBars.dense_lead, replaces it), and so does one too close to its next to tell.
+  /// Of 820 room pairs (seeds 1-200 at low and high noise, 1-10 noise-free;
+  /// g 0.1 and 0.05) the features answered 33, 10 of them wrong: the dense
+  /// search confirmed none of the 10 (its best pose elsewhere, or at most 1.08x
+  /// ahead) and 17 of the 23 right ones (1.22x and more).
+  double dense_opinion = 1.2;  ///< [ratio of scores]
+  /// A wide best pose confirms a thin feature answer over this many slices (of
+  /// those landing where the other map saw anything), not min_support: the two
+  /// searches, one on descriptors and one on occupancy, each find the pose on
+  /// their own, and more than one slice means more than a floor or the ground.
+  /// At min_support the matrix's kitti-lidar-16 (features on 2 slice pairs, the
+  /// wide search's best pose theirs, 2.05x ahead, over 2 slices) was refused,
+  /// which the paper's method answers right; at 2 it is answered, 0.07 m off,
+  /// and nothing else changed on the matrix, real-scan seeds 1-300 and rooms
+  /// seeds 1-100 (1,878 pairs).
+  int confirming_slices = 2;  ///< [slices]
+  /// Pooled occupancy is searched only where its cell stays this fine [m]
+  /// (maps at g 0.1 and finer): room pairs were measured up to there.
+  double coarsest_pooled_cell = 0.2;  ///< [m]
+};
+inline constexpr DecisionBars kBars{};
+
+/// Whether a winning answer with `support` agreeing slice pairs more than its
+/// runner-up is weak (DecisionBars::strong_winner).
+inline bool weakWinner(int support, const MatchParams& params) {
+  return support < kBars.strong_winner * params.min_support;
+}
 
 /// A pose's telling cells in the other map's empty space, per one landed on its occupancy.
 double contradiction(const DensePose& p);
-/// Whether a pose contradicts no more than kMostContradicted.
+/// Whether a pose contradicts no more than kBars.most_contradicted.
 bool consistent(const DensePose& p);
 /// Whether a pose is consistent over at least `min_support` slices.
 bool holdsOver(const DensePose& p, int min_support);
@@ -102,7 +160,7 @@ struct Evidence {
   std::optional<DenseEvidence> pooled;       ///< the dense search on occupancy pooled to twice the cell
   std::optional<SecondLook> second_look;     ///< of the search whose pose would answer (Needs::second_look)
   /// The best pose around the features' answer, beyond one consensus
-  /// tolerance and within kAroundTolerances of it (nearby_poses.hpp).
+  /// tolerance and within kBars.around_tolerances of it (nearby_poses.hpp).
   std::optional<DensePose> around_features;
   /// The features' distinct answers after the winner (rival_answers.hpp), as proposals.
   std::vector<Proposal> feature_rivals;
@@ -130,15 +188,15 @@ struct Verdict {
 /// The verdict on `e`. A feature answer that leads its runner-up clearly
 /// (weakWinner) stands alone. One the features refuse (fewer than min_support
 /// slice pairs, a runner-up within reach, fewer than min_inliers inliers) stands where the wide
-/// search's best pose lands on it and confirms it (kDenseOpinion, beyond
-/// chance, over kConfirmingSlices of the slices that land where the other map
+/// search's best pose lands on it and confirms it (kBars.dense_opinion, beyond
+/// chance, over kBars.confirming_slices of the slices that land where the other map
 /// saw anything): the one of the two poses that lands more telling cells is
 /// the answer. Where the wide search's best pose lies elsewhere, the features'
-/// pose stands if it lands more than that pose does (kDenseLead, beyond
+/// pose stands if it lands more than that pose does (kBars.dense_lead, beyond
 /// chance, over min_support of those slices) and, beyond chance, more than
-/// any pose around it (kAroundTolerances). Otherwise the dense search at the
+/// any pose around it (kBars.around_tolerances). Otherwise the dense search at the
 /// map's grid confirms it (its best pose is the features' and leads by
-/// kDenseOpinion), replaces it (its best pose elsewhere leads by kDenseLead),
+/// kBars.dense_opinion), replaces it (its best pose elsewhere leads by kBars.dense_lead),
 /// or refuses it;
 /// a search whose best pose contradicts what the other map saw empty found no
 /// place of its own, and the features' answer then stands if its own landing
@@ -147,8 +205,8 @@ struct Verdict {
 /// the search on pooled occupancy answers with a clear pose of its own,
 /// unless the search at the map's grid puts a clear best pose elsewhere
 /// (one holding over too few slices to answer). Every
-/// lead must also be beyond chance (kSignificant) and its pose hold
-/// (kMostContradicted, min_support slices). The pose of a dense search that
+/// lead must also be beyond chance (kBars.significant) and its pose hold
+/// (kBars.most_contradicted, min_support slices). The pose of a dense search that
 /// answers alone (at the map's grid or pooled) answers only where the same
 /// search with the maps' roles swapped finds it again and puts the source's
 /// frame origin where it does (preciseWhereStated).

@@ -159,7 +159,7 @@ TEST(DenseSearch, ThePosesAroundAPoseShowWhetherTheOccupancyPinsItDown) {
   two_threads.threads = 2;
   const DensePose at_room = landPose(room, room, right, 0),
                   near_room = bestAround(room, room, right, 0, 5, 20, two_threads);
-  EXPECT_GT(significance(at_room.score(), near_room.score()), kSignificant);
+  EXPECT_GT(significance(at_room.score(), near_room.score()), kBars.significant);
   const double apart = near_room.transform.t.norm();
   EXPECT_GT(apart, 5 * kGrid);
   EXPECT_LE(apart, 20 * kGrid + 1e-9);
@@ -174,7 +174,7 @@ TEST(DenseSearch, ThePosesAroundAPoseShowWhetherTheOccupancyPinsItDown) {
   const SliceStack rails = stackOf(street);
   const DensePose at_rails = landPose(rails, rails, right, 0), near_rails = bestAround(rails, rails, right, 0, 5, 20);
   ASSERT_GT(at_rails.score(), 0);
-  EXPECT_LT(significance(at_rails.score(), near_rails.score()), kSignificant);
+  EXPECT_LT(significance(at_rails.score(), near_rails.score()), kBars.significant);
 }
 
 // A pose a few cells and degrees off the right one, as a dense search's coarse
