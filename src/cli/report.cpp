@@ -195,7 +195,7 @@ std::vector<std::optional<GroundTruthCheck>> candidateChecks(const MatchResult& 
                                                              const std::optional<GroundTruth>& truth, double grid) {
   std::vector<std::optional<GroundTruthCheck>> out(r.candidates.size());
   if (truth)
-    for (size_t i = 0; i < out.size(); ++i) out[i] = checkAgainstGroundTruth(r.candidate_matrices[i], *truth, grid);
+    for (size_t i = 0; i < out.size(); ++i) out[i] = checkAgainstGroundTruth(r.candidates[i].T_own_frames, *truth, grid);
   return out;
 }
 

@@ -12,13 +12,17 @@ namespace {
 /// Places climbed at most: each climb lands thousands of poses.
 constexpr size_t kMostClimbs = 4;
 
-/// `out` with each candidate's landing, slice by slice.
-std::vector<Candidate> withSlices(std::vector<Candidate> out, const MapFeatures& target, const MapFeatures& source,
-                                  const DenseSearchParams& dp) {
+/// `out` with each candidate's landing, slice by slice, and its whole transform.
+std::vector<Candidate> finished(std::vector<Candidate> out, const MapFeatures& target, const MapFeatures& source,
+                                const DenseSearchParams& dp) {
   std::vector<std::pair<Rigid2D, int>> poses;
   for (const Candidate& c : out) poses.emplace_back(c.landed.transform, c.landed.offset);
   std::vector<std::vector<SliceLanding>> slices = landSlices(target.occupancy, source.occupancy, poses, dp);
-  for (size_t i = 0; i < out.size() && i < slices.size(); ++i) out[i].slices = std::move(slices[i]);
+  for (size_t i = 0; i < out.size(); ++i) {
+    if (i < slices.size()) out[i].slices = std::move(slices[i]);
+    out[i].T_own_frames = betweenOwnFrames(poseAt(out[i].landed.transform, out[i].landed.offset, target, source).matrix(),
+                                           target.slicedUp(), source.slicedUp());
+  }
   return out;
 }
 
@@ -53,13 +57,13 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
   std::vector<Candidate> out;
   for (size_t i = 0; i < proposals.size(); ++i) {
     const Proposal& p = proposals[i];
-    out.push_back({p.from, p.rank, p.feature_support, p.T, p.offset, as_proposed[i], as_proposed[i], {}});
+    out.push_back({p.from, p.rank, p.feature_support, p.T, p.offset, as_proposed[i], as_proposed[i], {}, Eigen::Matrix4d::Identity()});
   }
   // The best distinct places as proposed climb (small maps: on a large one
   // a climb takes seconds); two proposals are one place within looksApart
   // at the source's centre and the smear of heights.
   if (!denseSearchable(target.occupancy) || !denseSearchable(source.occupancy))
-    return withSlices(std::move(out), target, source, dp);
+    return finished(std::move(out), target, source, dp);
   std::vector<size_t> order(out.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
@@ -80,7 +84,7 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
     climbed.push_back(i);
     c.landed = uphill(land, target.occupancy, source.occupancy, c.proposed, c.proposed_offset, dp);
   }
-  return withSlices(std::move(out), target, source, dp);
+  return finished(std::move(out), target, source, dp);
 }
 
 }  // namespace tomomap

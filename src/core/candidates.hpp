@@ -1,6 +1,6 @@
 #pragma once
 // Candidate poses: what every search proposes, each refined and scored the
-// same way on the two maps' occupancy (docs/algorithm.md, "The decision").
+// same way on the two maps' occupancy (docs/algorithm.md, "Candidates").
 #include <vector>
 
 #include "dense_search.hpp"
@@ -20,6 +20,9 @@ struct Candidate {
   DensePose proposed_landed;  ///< the proposal landed as it is
   DensePose landed;           ///< refined (uphill, where it climbed) and landed
   std::vector<SliceLanding> slices;  ///< `landed`, source slice by source slice
+  /// `landed` as the whole transform between the maps' own frames (as
+  /// MatchResult::matrix() gives the answer's).
+  Eigen::Matrix4d T_own_frames = Eigen::Matrix4d::Identity();
 };
 
 const char* fromName(Candidate::From from);

@@ -4,8 +4,6 @@
 #include <chrono>
 #include <cmath>
 
-#include "gravity.hpp"
-
 #include "dense_refine.hpp"
 #include "dense_search.hpp"
 #include "height_offsets.hpp"
@@ -111,8 +109,7 @@ void answer(MatchResult& r, const Opinion& o, const DenseEvidence& e, const MapF
   r.method = "dense";
   r.dense_lead = e.lead();
   r.dense_cell = o.cell;
-  r.T_target_source = {best.transform.t.x(), best.transform.t.y(), heightShift(target, source, best.offset),
-                       wrapAngle(best.transform.yaw)};
+  r.T_target_source = poseAt(best.transform, best.offset, target, source);
   r.height_offset = best.offset;
   r.support = best.support;
   r.runner_up_support = d.poses.size() > 1 ? d.poses[1].support : 0;
@@ -155,8 +152,7 @@ void climbUphill(MatchResult& r, const std::vector<std::pair<Rigid2D, int>>& fou
   for (const DensePose& p : landed)
     if (p.score() > start->score() && significance(p.score(), landed.front().score()) >= kBars.significant) start = &p;
   const DensePose top = uphill(land, target.occupancy, source.occupancy, start->transform, start->offset, dp);
-  r.T_target_source = {top.transform.t.x(), top.transform.t.y(), heightShift(target, source, top.offset),
-                       wrapAngle(top.transform.yaw)};
+  r.T_target_source = poseAt(top.transform, top.offset, target, source);
   r.height_offset = top.offset;
 }
 
@@ -173,34 +169,34 @@ void takeOccupancyHeight(MatchResult& r, const MapFeatures& target, const MapFea
   r.T_target_source.z = heightShift(target, source, r.height_offset);
 }
 
-/// Every search run, and every pose proposed (the features' distinct answers,
-/// each search's four best) refined and landed into r.candidates
-/// (MatchParams::candidates).
+/// Proposed at most per dense search: its best distinct poses.
+constexpr size_t kProposalsPerSearch = 4;
+
+/// Every pose proposed (the features' distinct answers, each dense search's
+/// kProposalsPerSearch best) refined and landed into r.candidates
+/// (MatchParams::candidates). The searches the verdict ran are taken as
+/// they are; the ones it did not ask for run here.
 void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Proposal>& feature,
+                   std::optional<Opinion> at_grid, std::optional<Opinion> wide, std::optional<Opinion> at_pooled,
                    const MapFeatures& target, const MapFeatures& source, const MatchParams& params) {
   std::vector<Proposal> proposals;
   if (feature) proposals.push_back(*feature);
   for (const Proposal& p : e.feature_rivals) proposals.push_back(p);
-  const SliceStack ft = fullSlices(target.occupancy), fs = fullSlices(source.occupancy);
-  const auto add = [&](const Opinion& o, Candidate::From from) {
-    for (size_t i = 0; i < o.search.poses.size() && i < 4; ++i)
-      proposals.push_back({from, static_cast<int>(i), 0, o.search.poses[i].transform, o.search.poses[i].offset});
-  };
   if (denseSearchable(target.occupancy) && denseSearchable(source.occupancy)) {
-    add(searchAt(target, source, ft, fs, 1, params), Candidate::From::search_at_grid);
-    add(searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch()),
-        Candidate::From::search_wide);
-    if (target.grid <= 0.1 + 1e-9) {
-      const SliceStack pt = pooled(ft), ps = pooled(fs);
-      add(searchAt(target, source, pt, ps, 2, params), Candidate::From::search_pooled);
-    }
+    const SliceStack ft = fullSlices(target.occupancy), fs = fullSlices(source.occupancy);
+    if (!at_grid) at_grid = searchAt(target, source, ft, fs, 1, params);
+    if (!wide) wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch());
+    if (!at_pooled && 2 * target.grid <= kBars.coarsest_pooled_cell + 1e-9)
+      at_pooled = searchAt(target, source, pooled(ft), pooled(fs), 2, params);
   }
+  for (const auto& [o, from] : {std::pair{&at_grid, Candidate::From::search_at_grid},
+                                std::pair{&wide, Candidate::From::search_wide},
+                                std::pair{&at_pooled, Candidate::From::search_pooled}})
+    if (*o)
+      for (size_t i = 0; i < (*o)->search.poses.size() && i < kProposalsPerSearch; ++i)
+        proposals.push_back(
+            {from, static_cast<int>(i), 0, (*o)->search.poses[i].transform, (*o)->search.poses[i].offset});
   r.candidates = refineAndLand(target, source, proposals, params);
-  for (const Candidate& c : r.candidates) {
-    const Pose4 p{c.landed.transform.t.x(), c.landed.transform.t.y(), heightShift(target, source, c.landed.offset),
-                  c.landed.transform.yaw};
-    r.candidate_matrices.push_back(betweenOwnFrames(p.matrix(), target.slicedUp(), source.slicedUp()));
-  }
 }
 
 }  // namespace
@@ -281,7 +277,7 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
   const bool weighed = (e.at_grid && e.at_grid->found) || (e.wide && e.wide->found);
   if (r.reliable && weighed) climbUphill(r, found, target, source, params);
   if (r.reliable) takeOccupancyHeight(r, target, source);
-  if (params.candidates) allCandidates(r, e, feature, target, source, params);
+  if (params.candidates) allCandidates(r, e, feature, at_grid, wide, at_pooled, target, source, params);
   r.timings.dense = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 

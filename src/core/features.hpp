@@ -4,6 +4,7 @@
 #include <opencv2/features2d.hpp>
 
 #include "gravity.hpp"
+#include "rigid2d.hpp"
 #include "slices.hpp"
 
 namespace tomomap {
@@ -55,6 +56,11 @@ struct MapFeatures {
 /// The z of T_target_source that lays source slice k on target slice k + `offset` [m].
 inline double heightShift(const MapFeatures& target, const MapFeatures& source, int offset) {
   return target.sliceHeight(offset) - source.z_min;
+}
+
+/// T_target_source of a planar pose `T` at height offset `offset` [slices].
+inline Pose4 poseAt(const Rigid2D& T, int offset, const MapFeatures& target, const MapFeatures& source) {
+  return {T.t.x(), T.t.y(), heightShift(target, source, offset), wrapAngle(T.yaw)};
 }
 
 /// The ORB detector for one slice image: a single level, as the images are

@@ -112,8 +112,7 @@ void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const 
   const Refined refined = refineOffset(pairs, target, source, best.offset, best.consensus.mean, params);
   r.timings.refinement = secondsSince(t0);
 
-  r.T_target_source = {refined.T.t.x(), refined.T.t.y(), heightShift(target, source, best.offset),
-                       wrapAngle(refined.T.yaw)};
+  r.T_target_source = poseAt(refined.T, best.offset, target, source);
   r.inliers = refined.inliers.size();
   r.inlier_spread = inlierSpread(refined);
   e.support = r.support;

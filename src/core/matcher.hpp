@@ -92,10 +92,8 @@ struct MatchResult {
   size_t slice_pairs_recalled = 0;  ///< of slice_pairs, those a PairCache remembered instead of matched
   StageTimings timings;
   /// With MatchParams::candidates: every candidate pose the searches
-  /// proposed, refined and landed (candidates.hpp), and each one's whole
-  /// transform between the maps' own frames (as matrix() gives the answer's).
+  /// proposed, refined and landed (candidates.hpp).
   std::vector<Candidate> candidates;
-  std::vector<Eigen::Matrix4d> candidate_matrices;
 };
 
 /// Finds T_target_source from two feature stacks of the same grid size: slice

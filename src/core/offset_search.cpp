@@ -31,7 +31,7 @@ constexpr size_t kSamplesPerOffset = 8;
 /// diagonal, reaches this share of the best full support so far: a sample of
 /// 8 pairs misjudges an offset's support by up to about half (synth street
 /// and building, demo-room), and an answer with 1 / 1.25 of the winner's
-/// support already makes the match ambiguous (verdict.cpp, kBars.clear_ahead).
+/// support already makes the match ambiguous (verdict.hpp, DecisionBars::clear_ahead).
 constexpr double kRivalShare = 0.5;
 
 /// A winner under this many times min_support is checked against every pair:

@@ -162,7 +162,8 @@ struct Evidence {
   /// The best pose around the features' answer, beyond one consensus
   /// tolerance and within kBars.around_tolerances of it (nearby_poses.hpp).
   std::optional<DensePose> around_features;
-  /// The features' distinct answers after the winner (rival_answers.hpp), as proposals.
+  /// The features' distinct answers after the winner (rival_answers.hpp), as
+  /// proposals: gathered for MatchParams::candidates alone, not weighed here.
   std::vector<Proposal> feature_rivals;
 };
 
