@@ -351,7 +351,7 @@ void Agent::finishCompute() {
       "computed " + pairText(t.pair()) + " in " + fixed(t.seconds, 2) + " s (" + std::to_string(computed.slice_pairs) +
       " slice pairs, " + std::to_string(computed.slice_pairs_recalled) + " kept from its last match): " +
       (t.reliable ? "x " + fixed(T.x, 3) + " y " + fixed(T.y, 3) + " z " + fixed(T.z, 3) + " yaw " + fixed(T.yaw, 4) +
-                        ", support " + std::to_string(t.support) + ", " + std::to_string(t.inliers) + " inliers"
+                        ", by " + t.answered_by + ", " + fixed(t.lead_sigma, 1) + " sigma clear"
                   : "no reliable match: " + t.reason));
   bus_->publish(transport::toWire(t));
   const PairKey pair = t.pair();

@@ -29,8 +29,8 @@ void MatchWorker::start(const PairAt& pair, std::shared_ptr<const MapFeatures> t
     try {
       const MatchResult r = matchFeatures(*target, *source, params, {}, &caches_[pair.pair]);
       t = agreedFromMatch(pair, r, *target, *source, me);
-      c.slice_pairs = r.slice_pairs;
-      c.slice_pairs_recalled = r.slice_pairs_recalled;
+      c.slice_pairs = r.features.slice_pairs;
+      c.slice_pairs_recalled = r.features.slice_pairs_recalled;
     } catch (const std::exception& ex) {
       t = agreedFromMatch(pair, MatchResult{}, *target, *source, me);
       t.reason = ex.what();

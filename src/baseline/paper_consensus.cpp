@@ -4,6 +4,7 @@
 
 #include "core/height_offsets.hpp"
 #include "core/offset_search.hpp"
+#include "core/verdict.hpp"
 
 namespace tomomap::baseline {
 
@@ -21,8 +22,8 @@ MatchResult matchPaperConsensus(const Points& target, const Points& source, Matc
   }
   const auto t0 = std::chrono::steady_clock::now();
   const SlicePairTable pairs = matchSlicePairs(t, s, params, {});
-  r.slice_pairs = pairs.matchedCount();
-  r.slice_pairs_total = t.slices.size() * s.slices.size();
+  r.features.slice_pairs = pairs.matchedCount();
+  r.features.slice_pairs_total = t.slices.size() * s.slices.size();
   const std::vector<OffsetScore> scores = scoreOffsets(pairs, t, s, params);
   const OffsetChoice choice = pickOffset(scores, params, s.centre());
   r.timings.pair_matching = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -33,12 +34,13 @@ MatchResult matchPaperConsensus(const Points& target, const Points& source, Matc
   // The winning offset's consensus: the mean of its agreeing estimates.
   const OffsetScore& best = *choice.best;
   r.reliable = true;
-  r.support = static_cast<int>(best.consensus.support());
-  r.runner_up_support = choice.runner_up_support;
-  r.runner_up_offset = choice.runner_up_offset;
-  r.height_offset = best.offset;
-  r.T_target_source = {best.consensus.mean.t.x(), best.consensus.mean.t.y(), heightShift(t, s, best.offset),
-                       wrapAngle(best.consensus.mean.yaw)};
+  FeatureFindings& f = r.features;
+  f.support = static_cast<int>(best.consensus.support());
+  f.runner_up_support = choice.runner_up_support;
+  f.runner_up_offset = choice.runner_up_offset;
+  f.height_offset = r.height_offset = best.offset;
+  r.lead_sigma = significance(f.support, f.runner_up_support);
+  r.T_target_source = poseAt(best.consensus.mean, best.offset, t, s);
   return r;
 }
 

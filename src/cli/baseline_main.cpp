@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
     r.reliable = b.converged;
     if (!b.converged) r.reason = "FPFH-RANSAC did not converge";
     r.T_target_source = b.T_target_source;
-    r.inliers = static_cast<size_t>(b.inlier_fraction * static_cast<double>(b.source_keypoints));
+    r.features.inliers = static_cast<size_t>(b.inlier_fraction * static_cast<double>(b.source_keypoints));
     r.target_features = b.target_keypoints;
     r.source_features = b.source_keypoints;
     r.timings.features = b.describe_seconds;

@@ -102,7 +102,7 @@ FleetFrame matchAll(const std::vector<NamedMap>& maps, const std::vector<MapFeat
       const Pose4& T = a.T_target_source;
       std::cout << "pair             " << pairText(a.pair()) << ": "
                 << (a.reliable ? "x " + fixed(T.x, 3) + " y " + fixed(T.y, 3) + " z " + fixed(T.z, 3) + " m, yaw " +
-                                     fixed(degrees(T.yaw), 2) + " deg, support " + std::to_string(a.support)
+                                     fixed(degrees(T.yaw), 2) + " deg, " + a.answered_by + " " + fixed(a.lead_sigma, 1) + " sigma clear"
                                : "no reliable match: " + a.reason)
                 << "\n";
       agreed.push_back(std::move(a));

@@ -166,8 +166,9 @@ void printHuman(const json& status, const json& transforms, const json& frame, b
     } else {
       std::cout << "no reliable match: " << t.reason;
     }
-    std::cout << "\n        support " << t.support << " slice pairs (runner-up " << t.runner_up_support << "), "
-              << t.inliers << " inliers; computed by " << t.computed_by << " in " << fixed(t.seconds, 2) << " s, "
+    std::cout << "\n        ";
+    if (t.reliable) std::cout << "answered by " << t.answered_by << ", " << fixed(t.lead_sigma, 1) << " sigma clear; ";
+    std::cout << "computed by " << t.computed_by << " in " << fixed(t.seconds, 2) << " s, "
               << ago(static_cast<double>(t.computed_at_ms));
     const bool current =
         versions.count(t.target) && versions.count(t.source) && t.isFor(versions.at(t.target), versions.at(t.source));

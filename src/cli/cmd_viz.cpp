@@ -33,8 +33,10 @@ int runViz(const VizOptions& o) {
       fs::path(o.files.source).filename().string() + " aligned onto " + fs::path(o.files.target).filename().string() +
           " (walls and other vertical structure, seen from above)",
       "T_target_source: x " + fixed(T.x, 3) + " m, y " + fixed(T.y, 3) + " m, z " + fixed(T.z, 3) + " m, yaw " +
-          fixed(degrees(T.yaw), 2) + " deg;  support " + std::to_string(r.support) + " slice pairs, " +
-          std::to_string(r.inliers) + " inliers"};
+          fixed(degrees(T.yaw), 2) + " deg;  " +
+          (r.reliable ? std::string(fromName(r.answered_by)) + ", " + fixed(r.lead_sigma, 1) + " sigma clear; " : "") +
+          "features: " + std::to_string(r.features.support) + " slice pairs, " + std::to_string(r.features.inliers) +
+          " inliers"};
   if (!r.reliable) caption.push_back("NO RELIABLE MATCH (" + r.reason + "): showing the best candidate");
   if (gt)
     caption.push_back("against ground truth: " + fixed(gt->error.translation, 3) + " m, " +

@@ -75,24 +75,29 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
   }
   if (method == "fpfh-ransac") {
     out << format("keypoints        target %zu, source %zu, %zu inliers\n", r.target_features, r.source_features,
-                  r.inliers);
+                  r.features.inliers);
     out << format("time             %.3f s: normals + FPFH %.3f, RANSAC %.3f\n", r.timings.total(), r.timings.features,
                   r.timings.pair_matching);
   } else {
-    out << format(
-        "quality          support %d slice pairs (runner-up %d), %zu inliers, spread x %.2f y %.2f z %.2f m\n",
-        r.support, r.runner_up_support, r.inliers, r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z());
-    if (r.dense_lead > 0)
-      out << format("dense search     %s; at %.2f m cells its best pose leads the next by %.2fx\n",
-                    r.method == "dense" ? "found this answer" : "ran beside the features", r.dense_cell, r.dense_lead);
-    if (r.dense_pooled_lead > 0)
-      out << format("                 on occupancy pooled to twice the cell: %.2fx\n", r.dense_pooled_lead);
-    if (r.dense_wide_lead > 0)
+    if (r.reliable)
+      out << format("answered by      %s, %.1f sigma clear of the best answer elsewhere\n", fromName(r.answered_by),
+                    r.lead_sigma);
+    const FeatureFindings& f = r.features;
+    if (f.support > 0)
+      out << format(
+          "features         %d slice pairs agree (runner-up %d), %zu inliers, spread x %.2f y %.2f z %.2f m\n",
+          f.support, f.runner_up_support, f.inliers, f.inlier_spread.x(), f.inlier_spread.y(), f.inlier_spread.z());
+    const DenseFindings& d = r.dense;
+    if (d.at_grid_lead > 0)
+      out << format("dense search     at the map's cells its best pose leads the next by %.2fx\n", d.at_grid_lead);
+    if (d.pooled_lead > 0)
+      out << format("                 on occupancy pooled to twice the cell: %.2fx\n", d.pooled_lead);
+    if (d.wide_lead > 0)
       out << format("                 on a raster twice as fine, checking the features' answer: %.2fx\n",
-                    r.dense_wide_lead);
-    if (r.dense_second_look_apart)
+                    d.wide_lead);
+    if (d.second_look_apart)
       out << format("                 with the maps' roles swapped, the source's origin %.3f m from its pose\n",
-                    *r.dense_second_look_apart);
+                    *d.second_look_apart);
     out << "tilt             target " << tiltText(r.target_tilt) << ", source " << tiltText(r.source_tilt) << "\n";
     if (r.finish && r.finish->held)
       out << format(
@@ -104,7 +109,8 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
       out << "6-DoF finish     kept the 4-DoF answer: " << r.finish->why_not << "\n";
     out << format(
         "slices           target %d (%zu features), source %d (%zu features), %zu of %zu slice pairs matched\n",
-        r.target_slices, r.target_features, r.source_slices, r.source_features, r.slice_pairs, r.slice_pairs_total);
+        r.target_slices, r.target_features, r.source_slices, r.source_features, r.features.slice_pairs,
+        r.features.slice_pairs_total);
     const auto& t = r.timings;
     out << format(
         "time             %.3f s: load %.3f, voxel %.3f, slicing %.3f, features %.3f, pair matching %.3f, "
@@ -146,23 +152,27 @@ nlohmann::json toJson(const MatchResult& r, const std::optional<GroundTruthCheck
   } else {
     j["finish"] = nullptr;
   }
-  j["quality"] = {{"method", r.method},
-                  {"dense_lead", r.dense_lead},
-                  {"dense_cell", r.dense_cell},
-                  {"dense_pooled_lead", r.dense_pooled_lead},
-                  {"dense_wide_lead", r.dense_wide_lead},
-                  {"dense_second_look_m",
-                   r.dense_second_look_apart ? nlohmann::json(*r.dense_second_look_apart) : nlohmann::json()},
-                  {"support", r.support},
-                  {"height_offset_slices", r.height_offset},
-                  {"runner_up_support", r.runner_up_support},
-                  {"runner_up_offset_slices", r.runner_up_offset},
-                  {"inliers", r.inliers},
-                  {"inlier_spread", {r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z()}}};
+  if (r.reliable) {
+    j["answered_by"] = fromName(r.answered_by);
+    j["lead_sigma"] = r.lead_sigma;
+    j["height_offset_slices"] = r.height_offset;
+  }
+  const FeatureFindings& f = r.features;
+  j["features"] = {{"support", f.support},
+                   {"height_offset_slices", f.height_offset},
+                   {"runner_up_support", f.runner_up_support},
+                   {"runner_up_offset_slices", f.runner_up_offset},
+                   {"inliers", f.inliers},
+                   {"inlier_spread", {f.inlier_spread.x(), f.inlier_spread.y(), f.inlier_spread.z()}}};
+  const DenseFindings& d = r.dense;
+  j["dense"] = {{"at_grid_lead", d.at_grid_lead},
+                {"wide_lead", d.wide_lead},
+                {"pooled_lead", d.pooled_lead},
+                {"second_look_m", d.second_look_apart ? nlohmann::json(*d.second_look_apart) : nlohmann::json()}};
   j["slices"] = {{"target", r.target_slices},
                  {"source", r.source_slices},
-                 {"pairs", r.slice_pairs},
-                 {"pairs_total", r.slice_pairs_total},
+                 {"pairs", f.slice_pairs},
+                 {"pairs_total", f.slice_pairs_total},
                  {"target_features", r.target_features},
                  {"source_features", r.source_features}};
   const auto& t = r.timings;

@@ -44,6 +44,14 @@ const char* fromName(Candidate::From from) {
   return "?";
 }
 
+std::optional<Candidate::From> fromName(const std::string& name) {
+  for (const Candidate::From from : {Candidate::From::features, Candidate::From::feature_rival,
+                                     Candidate::From::search_at_grid, Candidate::From::search_wide,
+                                     Candidate::From::search_pooled})
+    if (name == fromName(from)) return from;
+  return std::nullopt;
+}
+
 std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeatures& source,
                                      const std::vector<Proposal>& proposals, const MatchParams& params) {
   if (target.occupancy.partial || source.occupancy.partial || proposals.empty()) return {};

@@ -1,6 +1,8 @@
 #pragma once
 // Candidate poses: what every search proposes, each refined and scored the
 // same way on the two maps' occupancy (docs/algorithm.md, "Candidates").
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "dense_search.hpp"
@@ -26,6 +28,8 @@ struct Candidate {
 };
 
 const char* fromName(Candidate::From from);
+/// The inverse: the search a name names; empty for any other text.
+std::optional<Candidate::From> fromName(const std::string& name);
 
 /// A proposal: a pose, its height offset, where it came from.
 struct Proposal {

@@ -101,22 +101,11 @@ SecondLook lookAgain(const Opinion& o, const MapFeatures& target, const MapFeatu
   return look;
 }
 
-/// `r` answered by the opinion's best pose (`method` "dense"); `e`, the verdict's view of it.
-void answer(MatchResult& r, const Opinion& o, const DenseEvidence& e, const MapFeatures& target,
-            const MapFeatures& source) {
-  const DenseSearch& d = o.search;
+/// `r` answered by the opinion's best pose.
+void answer(MatchResult& r, const Opinion& o, const MapFeatures& target, const MapFeatures& source) {
   const DensePose& best = o.best();
-  r.method = "dense";
-  r.dense_lead = e.lead();
-  r.dense_cell = o.cell;
   r.T_target_source = poseAt(best.transform, best.offset, target, source);
   r.height_offset = best.offset;
-  r.support = best.support;
-  r.runner_up_support = d.poses.size() > 1 ? d.poses[1].support : 0;
-  r.runner_up_offset = d.poses.size() > 1 ? d.poses[1].offset : 0;
-  r.supporters.clear();
-  r.inliers = best.inliers;
-  r.inlier_spread = Eigen::Vector3d::Zero();
 }
 
 /// `r`'s pose moved uphill on the maps' occupancy (nearby_poses.hpp), where
@@ -204,9 +193,9 @@ void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Propos
 void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const MapFeatures& source,
                  const MatchParams& params) {
   const auto t0 = std::chrono::steady_clock::now();
-  const bool features = r.support > 0;  // the features proposed an answer (judged or not)
+  const bool features = r.features.support > 0;  // the features proposed an answer (judged or not)
   const std::optional<Proposal> feature =
-      features ? std::optional<Proposal>(Proposal{Candidate::From::features, 0, r.support, planar(r.T_target_source),
+      features ? std::optional<Proposal>(Proposal{Candidate::From::features, 0, r.features.support, planar(r.T_target_source),
                                                   r.height_offset})
                : std::nullopt;
   std::optional<Opinion> at_grid, wide, at_pooled;
@@ -223,12 +212,12 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
         full();
         at_grid = searchAt(target, source, *full_target, *full_source, 1, params);
         e.at_grid = evidenceOf(*at_grid, r, features, target, source);
-        if (at_grid->found()) r.dense_lead = e.at_grid->lead(), r.dense_cell = at_grid->cell;
+        if (at_grid->found()) r.dense.at_grid_lead = e.at_grid->lead();
         break;
       case Verdict::Needs::wide_search:
         wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch());
         e.wide = evidenceOf(*wide, r, features, target, source);
-        if (wide->found()) r.dense_wide_lead = e.wide->lead();
+        if (wide->found()) r.dense.wide_lead = e.wide->lead();
         break;
       case Verdict::Needs::features_landed:
         e.features_landed = landPose(target.occupancy, source.occupancy, planar(r.T_target_source), r.height_offset);
@@ -241,13 +230,13 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
         e.pooled = evidenceOf(*at_pooled, r, features, target, source);
         e.pooled->at_grid_best = e.pooled->found && at_grid && at_grid->found() &&
                                  isBestPose(*at_pooled, at_grid->best().transform, at_grid->best().offset, source);
-        if (at_pooled->found()) r.dense_pooled_lead = e.pooled->lead();
+        if (at_pooled->found()) r.dense.pooled_lead = e.pooled->lead();
         break;
       case Verdict::Needs::second_look:
         e.second_look = v.by == Verdict::By::pooled
                             ? lookAgain(*at_pooled, target, source, *pooled_target, *pooled_source, params)
                             : lookAgain(*at_grid, target, source, *full_target, *full_source, params);
-        if (e.second_look->found) r.dense_second_look_apart = e.second_look->apart;
+        if (e.second_look->found) r.dense.second_look_apart = e.second_look->apart;
         break;
       case Verdict::Needs::around_features: {
         const int tolerance = static_cast<int>(params.consensus_translation_cells);
@@ -268,9 +257,11 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
     if (*o && (*o)->found()) found.emplace_back((*o)->best().transform, (*o)->best().offset);
   r.reliable = v.by != Verdict::By::none;
   r.reason = v.reason;
-  if (v.by == Verdict::By::at_grid) answer(r, *at_grid, *e.at_grid, target, source);
-  if (v.by == Verdict::By::wide) answer(r, *wide, *e.wide, target, source);
-  if (v.by == Verdict::By::pooled) answer(r, *at_pooled, *e.pooled, target, source);
+  r.answered_by = answeredBy(v.by);
+  r.lead_sigma = r.reliable ? answerLead(e, v.by) : 0.0;
+  if (v.by == Verdict::By::at_grid) answer(r, *at_grid, target, source);
+  if (v.by == Verdict::By::wide) answer(r, *wide, target, source);
+  if (v.by == Verdict::By::pooled) answer(r, *at_pooled, target, source);
   // An answer the occupancy weighed (a dense search found poses) is placed by
   // it too; a clear feature winner, or one on a map too large to search, is
   // placed by its keypoints.

@@ -58,6 +58,7 @@ Pose4 fourDofAbout(const Eigen::Matrix4d& T, const Eigen::Vector3d& c) {
 void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const MapFeatures& source,
                  const MatchParams& params, const Progress& progress, PairCache* cache) {
   FeatureEvidence& e = ev.features;
+  FeatureFindings& f = r.features;
   const size_t nt = target.slices.size(), ns = source.slices.size();
   if (nt < static_cast<size_t>(params.min_support) || ns < static_cast<size_t>(params.min_support)) {
     e.missing = "too few descriptive slices (target " + std::to_string(nt) + ", source " + std::to_string(ns) +
@@ -67,9 +68,9 @@ void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const 
   auto t0 = Clock::now();
   const SlicePairTable pairs = matchSlicePairs(target, source, params, progress, cache);
   if (cache) cache->keep(pairs, params);
-  r.slice_pairs = pairs.matchedCount();
-  r.slice_pairs_total = nt * ns;
-  r.slice_pairs_recalled = pairs.recalled;
+  f.slice_pairs = pairs.matchedCount();
+  f.slice_pairs_total = nt * ns;
+  f.slice_pairs_recalled = pairs.recalled;
   r.timings.pair_matching = secondsSince(t0);
 
   t0 = Clock::now();
@@ -81,21 +82,21 @@ void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const 
     return;
   }
   OffsetScore best = *choice.best;
-  r.runner_up_support = choice.runner_up_support;
-  r.runner_up_offset = choice.runner_up_offset;
+  f.runner_up_support = choice.runner_up_support;
+  f.runner_up_offset = choice.runner_up_offset;
   // A weak winner's rivals are weighed on the occupancy: the answer whose
   // landing holds and clearly outscores the rest, against the answers that
   // hold too. The full-size building at g 0.2 (seed 3): the winner, a copy
   // one room along (10 slice pairs), and the right pose at the same offset
   // (10 too).
-  if (weakWinner(static_cast<int>(best.consensus.support()) - r.runner_up_support, params))
+  if (weakWinner(static_cast<int>(best.consensus.support()) - f.runner_up_support, params))
     if (const auto landed = chooseByLanding(pairs, target, source, params)) {
       if (!sameAnswer(landed->answer, best, params, source.centre())) best = landed->answer;
-      r.runner_up_support = landed->rival_support;
-      r.runner_up_offset = landed->rival_offset;
+      f.runner_up_support = landed->rival_support;
+      f.runner_up_offset = landed->rival_offset;
     }
-  r.support = static_cast<int>(best.consensus.support());
-  r.height_offset = best.offset;
+  f.support = static_cast<int>(best.consensus.support());
+  f.height_offset = best.offset;
   if (params.candidates) {
     int rank = 0;
     for (const OffsetScore& a : distinctAnswers(pairs, target, source, params))
@@ -104,21 +105,23 @@ void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const 
                             a.consensus.mean, a.offset});
   }
   for (size_t k : best.consensus.supporters)
-    r.supporters.push_back({target.slices[k / ns].index, source.slices[k % ns].index, pairs.estimates[k].inliers});
-  std::stable_sort(r.supporters.begin(), r.supporters.end(),
+    f.supporters.push_back({target.slices[k / ns].index, source.slices[k % ns].index, pairs.estimates[k].inliers});
+  std::stable_sort(f.supporters.begin(), f.supporters.end(),
                    [](const SupportingPair& x, const SupportingPair& y) { return x.inliers > y.inliers; });
 
   t0 = Clock::now();
   const Refined refined = refineOffset(pairs, target, source, best.offset, best.consensus.mean, params);
   r.timings.refinement = secondsSince(t0);
 
+  // The features' answer is the answer until the verdict says otherwise (dense_opinion.hpp).
   r.T_target_source = poseAt(refined.T, best.offset, target, source);
-  r.inliers = refined.inliers.size();
-  r.inlier_spread = inlierSpread(refined);
-  e.support = r.support;
-  e.runner_up_support = r.runner_up_support;
-  e.runner_up_gap = std::abs(r.runner_up_offset - r.height_offset);
-  e.inliers = r.inliers;
+  r.height_offset = best.offset;
+  f.inliers = refined.inliers.size();
+  f.inlier_spread = inlierSpread(refined);
+  e.support = f.support;
+  e.runner_up_support = f.runner_up_support;
+  e.runner_up_gap = std::abs(f.runner_up_offset - f.height_offset);
+  e.inliers = f.inliers;
 }
 
 }  // namespace

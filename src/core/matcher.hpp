@@ -34,6 +34,35 @@ struct SupportingPair {
   uint32_t inliers = 0;                    ///< RANSAC inliers of that pair's own estimate
 };
 
+/// What the tomographic match found, whatever the verdict made of it: each
+/// field means the same whichever search answered.
+struct FeatureFindings {
+  int support = 0;            ///< agreeing slice pairs behind the features' answer; 0: they had none
+  int runner_up_support = 0;  ///< of their best other answer (height_offsets.hpp OffsetChoice)
+  int runner_up_offset = 0;   ///< its height offset [slices]
+  int height_offset = 0;      ///< the features' answer's height offset [slices]
+  std::vector<SupportingPair> supporters;                   ///< the slice pairs behind `support`, most inliers first
+  size_t inliers = 0;                                       ///< feature correspondences consistent with their answer
+  Eigen::Vector3d inlier_spread = Eigen::Vector3d::Zero();  ///< std. dev. of those inliers in target x, y, z [m]
+  size_t slice_pairs = 0;           ///< slice pairs matched (all, or those the offset votes point to)
+  size_t slice_pairs_total = 0;     ///< n_target x n_source slices with features
+  size_t slice_pairs_recalled = 0;  ///< of slice_pairs, those a PairCache remembered instead of matched
+};
+
+/// What the dense searches of small maps found (dense_opinion.hpp), each
+/// search's best pose over its next in DensePose::score (dense_search.hpp);
+/// 0 where that search did not run or found nothing.
+struct DenseFindings {
+  double at_grid_lead = 0;  ///< the search on the maps' own cells, full slices
+  double wide_lead = 0;     ///< the search on a raster twice as fine (kWideCoarseSide)
+  double pooled_lead = 0;   ///< the search on occupancy pooled to twice the cell
+  /// Where the search whose pose would answer, asked again with the maps'
+  /// roles swapped, put the source's frame origin, apart from that pose [m]
+  /// (verdict.hpp, SecondLook); unset where it was not asked or found none.
+  std::optional<double> second_look_apart;
+};
+
+/// The answer to one match, then what each search found on the way.
 struct MatchResult {
   /// False means "no reliable match": T_target_source is then meaningless and
   /// must not be used; `reason` says why.
@@ -51,45 +80,26 @@ struct MatchResult {
   /// The 6-DoF finish of a reliable answer (six_dof_finish.hpp): what it
   /// corrected, or why it kept the 4-DoF answer. Empty where it did not run.
   std::optional<SixDofFinish> finish;
+  /// The search whose pose is the answer (reliable only): the features
+  /// (Candidate::From::features) or one of the dense searches.
+  Candidate::From answered_by = Candidate::From::features;
+  /// Winning target slice index - source slice index of the answer (small
+  /// maps: where the occupancy meets best, dense_opinion.hpp).
+  int height_offset = 0;
+  /// How clearly the evidence singles out the answer: its lead over the best
+  /// answer elsewhere, in standard deviations of a difference of two counts
+  /// (verdict.hpp, answerLead), the strongest of the searches that found it.
+  /// The fleet's pose graph weighs the pair by it. 0 when not reliable.
+  double lead_sigma = 0;
   double target_tilt = 0, source_tilt = 0;  ///< as measured before any levelling [rad]; -1 = not measurable
 
   /// The transform to apply to source points to bring them into the target's frame.
   Eigen::Matrix4d matrix() const { return T_target_source_6dof.value_or(T_target_source.matrix()); }
 
-  /// What found T: "features" (the tomographic match) or "dense" (the dense
-  /// search of small maps, when the verdict (verdict.hpp) takes its answer).
-  std::string method = "features";
-  /// Small maps only: the dense search's winner over its best other pose, in
-  /// DensePose::score (dense_search.hpp); 0 when it did not run.
-  double dense_lead = 0;
-  /// The cell [m] of the search behind dense_lead: the map's grid, or twice
-  /// it where the search on pooled occupancy answered alone; 0 when none ran.
-  double dense_cell = 0;
-  /// The dense search's lead on occupancy pooled to twice the cell, where the
-  /// map's grid left the pair refused; 0 when it did not run.
-  double dense_pooled_lead = 0;
-  /// The lead of the search on a raster twice as fine, asked where the
-  /// features found an answer on too few slice pairs (verdict.hpp); 0 when it did not run.
-  double dense_wide_lead = 0;
-  /// Where the dense search with the maps' roles swapped put the source's
-  /// frame origin, apart from the dense answer's [m] (verdict.hpp,
-  /// SecondLook); unset when it was not asked or found no pose.
-  std::optional<double> dense_second_look_apart;
-  int support = 0;            ///< agreeing slice pairs at the winning height offset
-  int runner_up_support = 0;  ///< best support of another answer (OffsetChoice)
-  int runner_up_offset = 0;   ///< its height offset [slices]
-  /// Winning target slice index - source slice index (small maps: where the
-  /// occupancy meets best, dense_opinion.hpp).
-  int height_offset = 0;
-  std::vector<SupportingPair> supporters;                   ///< the slice pairs behind `support`, most inliers first
-  size_t inliers = 0;                                       ///< feature correspondences consistent with the result
-  Eigen::Vector3d inlier_spread = Eigen::Vector3d::Zero();  ///< std. dev. of inliers in target x, y, z [m]
-
+  FeatureFindings features;
+  DenseFindings dense;
   int target_slices = 0, source_slices = 0;
   size_t target_features = 0, source_features = 0;
-  size_t slice_pairs = 0;           ///< slice pairs matched (all, or those the offset votes point to)
-  size_t slice_pairs_total = 0;     ///< n_target x n_source slices with features
-  size_t slice_pairs_recalled = 0;  ///< of slice_pairs, those a PairCache remembered instead of matched
   StageTimings timings;
   /// With MatchParams::candidates: every candidate pose the searches
   /// proposed, refined and landed (candidates.hpp).

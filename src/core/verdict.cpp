@@ -170,6 +170,39 @@ double significance(double a, double b) {
   return (a - b) / std::sqrt(std::max(a + b, 1.0));
 }
 
+Candidate::From answeredBy(Verdict::By by) {
+  switch (by) {
+    case Verdict::By::at_grid:
+      return Candidate::From::search_at_grid;
+    case Verdict::By::wide:
+      return Candidate::From::search_wide;
+    case Verdict::By::pooled:
+      return Candidate::From::search_pooled;
+    case Verdict::By::none:
+    case Verdict::By::features:
+      break;
+  }
+  return Candidate::From::features;
+}
+
+double answerLead(const Evidence& e, Verdict::By by) {
+  if (by == Verdict::By::none) return 0.0;
+  const std::pair<const std::optional<DenseEvidence>*, Verdict::By> searches[] = {
+      {&e.at_grid, Verdict::By::at_grid}, {&e.wide, Verdict::By::wide}, {&e.pooled, Verdict::By::pooled}};
+  // The answer is the features' place when they answered, or when the
+  // search that answered put its best pose there.
+  bool at_features = by == Verdict::By::features;
+  for (const auto& [d, which] : searches)
+    if (which == by && *d && (*d)->at_features) at_features = true;
+  double lead = 0.0;
+  if (at_features && e.features.support > 0)
+    lead = significance(e.features.support, e.features.runner_up_support);
+  for (const auto& [d, which] : searches)
+    if (*d && (*d)->found && (which == by || (at_features && (*d)->at_features)))
+      lead = std::max(lead, significance((*d)->best.score(), (*d)->next_score));
+  return lead;
+}
+
 double DenseEvidence::lead() const { return leadOver(best.score(), next_score); }
 
 Verdict decideMatch(const Evidence& e, const MatchParams& params) {

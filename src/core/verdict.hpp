@@ -186,6 +186,16 @@ struct Verdict {
   Needs needs = Needs::nothing;
 };
 
+/// The candidate source behind a verdict's answer (By::none: features).
+Candidate::From answeredBy(Verdict::By by);
+
+/// How clearly `e` singles out the answer `by` names (MatchResult::lead_sigma):
+/// the significance of its lead over the best answer elsewhere, in the
+/// answering search and in every other search that found the same place (the
+/// features: agreeing slice pairs over the runner-up's; a dense search: its
+/// best pose's score over its next's), the strongest of them; 0 for By::none.
+double answerLead(const Evidence& e, Verdict::By by);
+
 /// The verdict on `e`. A feature answer that leads its runner-up clearly
 /// (weakWinner) stands alone. One the features refuse (fewer than min_support
 /// slice pairs, a runner-up within reach, fewer than min_inliers inliers) stands where the wide

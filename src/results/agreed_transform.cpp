@@ -1,5 +1,6 @@
 #include "agreed_transform.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 #include "core/gravity.hpp"
@@ -33,10 +34,8 @@ AgreedTransform agreedOf(const MatchResult& r, const MapFeatures& target, const 
   t.target_up = target.slicedUp();
   t.source_up = source.slicedUp();
   t.T_target_source_6dof = r.T_target_source_6dof;
-  t.support = r.support;
-  t.runner_up_support = r.runner_up_support;
-  t.inliers = static_cast<uint32_t>(r.inliers);
-  t.spread = {r.inlier_spread.x(), r.inlier_spread.y(), r.inlier_spread.z()};
+  t.answered_by = fromName(r.answered_by);
+  t.lead_sigma = r.lead_sigma;
   return t;
 }
 
@@ -90,10 +89,7 @@ nlohmann::json toJson(const AgreedTransform& t) {
   } else {
     j["reason"] = t.reason;
   }
-  j["quality"] = {{"support", t.support},
-                  {"runner_up_support", t.runner_up_support},
-                  {"inliers", t.inliers},
-                  {"inlier_spread", t.spread}};
+  j["quality"] = {{"answered_by", t.answered_by}, {"lead_sigma", t.lead_sigma}};
   return j;
 }
 
@@ -119,11 +115,13 @@ AgreedTransform agreedFromJson(const nlohmann::json& j) {
     } else {
       t.reason = j.value("reason", "");
     }
+    // Files of schema 2 weighed pairs by slice pairs, which meant cells for
+    // a dense answer: their pairs come back as the least clear answers.
     const auto& q = j.at("quality");
-    t.support = q.at("support").get<int>();
-    t.runner_up_support = q.at("runner_up_support").get<int>();
-    t.inliers = q.at("inliers").get<uint32_t>();
-    t.spread = q.at("inlier_spread").get<std::array<double, 3>>();
+    t.answered_by = q.value("answered_by", fromName(Candidate::From::features));
+    t.lead_sigma = q.value("lead_sigma", 0.0);
+    if (!std::isfinite(t.lead_sigma) || t.lead_sigma < 0) throw InputError("a quality.lead_sigma that is not a number >= 0");
+    if (!fromName(t.answered_by)) throw InputError("a quality.answered_by that names no search: " + t.answered_by);
     return t;
   } catch (const nlohmann::json::exception& e) {
     throw InputError(std::string("not a stored transform: ") + e.what());

@@ -43,10 +43,11 @@ struct AgreedTransform {
   /// The whole transform between the maps' own frames where the matcher gave
   /// one (the 6-DoF finish's); otherwise ownFrames() derives it from the above.
   std::optional<Eigen::Matrix4d> T_target_source_6dof;
-  int support = 0;  ///< agreeing slice pairs
-  int runner_up_support = 0;
-  uint32_t inliers = 0;
-  std::array<double, 3> spread{};  ///< std. dev. of the inliers in target x, y, z [m]
+  /// The search whose pose is the answer (candidates.hpp fromName).
+  std::string answered_by = fromName(Candidate::From::features);
+  /// How clearly the match singled the answer out (MatchResult::lead_sigma)
+  /// [standard deviations]: the fleet's pose graph weighs the pair by it.
+  double lead_sigma = 0;
   std::string computed_by;
   uint64_t computed_at_ms = 0;  ///< the computing agent's wall clock [ms since the epoch]
   double seconds = 0;           ///< matching time [s]

@@ -142,7 +142,7 @@ bool closes(const PairVerdict& v, const CycleLimits& limits) {
 }
 
 /// Sets aside, one at a time, the link whose loops fail most often (then
-/// the one on more failing loops, then the least supported, then the first
+/// the one on more failing loops, then the least clear (lead_sigma), then the first
 /// by key) until every loop closes. A wrong link fails every loop it is on;
 /// a right one only those it shares with a wrong one. Returns the verdict of
 /// each link set aside: the first failing loop it was on.
@@ -172,7 +172,7 @@ std::map<size_t, PairVerdict> setAsideContradictions(PairGraph& g, const CycleLi
       const long lhs = static_cast<long>(failing[a]) * checked[b], rhs = static_cast<long>(failing[b]) * checked[a];
       if (lhs != rhs) return lhs > rhs;
       if (failing[a] != failing[b]) return failing[a] > failing[b];
-      return g.link(a).support < g.link(b).support;
+      return g.link(a).lead_sigma < g.link(b).lead_sigma;
     };
     for (size_t e = 0; e < g.size(); ++e)
       if (failing[e] > 0 && (!worst || worse(e, *worst))) worst = e;
@@ -205,7 +205,8 @@ struct PairResidual {
 };
 
 /// Refines `poses` (the reference's held fixed) over the active links: least
-/// squares weighted by support, Huber beyond the limits so that a bad link
+/// squares weighted by how clearly each pair's match singled its answer out
+/// (lead_sigma, at least 1), Huber beyond the limits so that a bad link
 /// the cycle checks could not see (on no loop) pulls less.
 bool optimise(const PairGraph& g, const std::string& reference, std::map<std::string, Pose4>& poses,
               const CycleLimits& limits, size_t& used) {
@@ -217,7 +218,7 @@ bool optimise(const PairGraph& g, const std::string& reference, std::map<std::st
     const AgreedTransform& t = g.link(e);
     if (!g.active(e) || !blocks.count(t.target) || !blocks.count(t.source)) continue;
     auto* cost = new ceres::AutoDiffCostFunction<PairResidual, 4, 4, 4>(new PairResidual{t.T_target_source, limits});
-    auto* loss = new ceres::ScaledLoss(new ceres::HuberLoss(1.0), std::max(1, t.support), ceres::TAKE_OWNERSHIP);
+    auto* loss = new ceres::ScaledLoss(new ceres::HuberLoss(1.0), std::max(1.0, t.lead_sigma), ceres::TAKE_OWNERSHIP);
     problem.AddResidualBlock(cost, loss, blocks[t.target].data(), blocks[t.source].data());
     ++used;
   }
@@ -284,7 +285,7 @@ FleetFrame buildFleetFrame(const std::vector<AgreedTransform>& agreed, const std
     frame.pairs.push_back(std::move(v));
   }
 
-  // Start from the best-supported tree over the consistent pairs.
+  // Start from the tree of the clearest links over the consistent pairs.
   std::vector<AgreedTransform> kept;
   for (size_t e = 0; e < g.size(); ++e)
     if (g.active(e)) kept.push_back(g.link(e));

@@ -42,7 +42,7 @@ struct AgentPose {
   /// Its map's up in its own frame (z where it was sliced as it is).
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   /// How it is reached: the reference, the agents in between, the agent
-  /// (the best-supported links; the pose itself comes from every pair).
+  /// (the clearest links, by lead_sigma; the pose itself comes from every pair).
   std::vector<std::string> path;
 };
 
@@ -64,9 +64,9 @@ struct FleetFrame {
 /// The frame of `agents` in `reference`'s map from the reliable pairs of
 /// `agreed`. Cycle checks: each pair is compared with the shortest other
 /// path between its two maps; while some loop misses closing by more than
-/// `limits`, the pair on the most failing loops (then the least supported) is
+/// `limits`, the pair on the most failing loops (then the least clear, lead_sigma) is
 /// put aside. The rest are solved together (Ceres, Huber loss), starting from
-/// the best-supported tree.
+/// the tree of the clearest links.
 FleetFrame buildFleetFrame(const std::vector<AgreedTransform>& agreed, const std::vector<std::string>& agents,
                            const std::string& reference, const CycleLimits& limits);
 

@@ -7,7 +7,7 @@ namespace tomomap {
 std::vector<TreeEdge> spanningTree(const std::vector<AgreedTransform>& agreed, const std::string& root) {
   std::vector<TreeEdge> tree;
   std::set<std::string> in{root};
-  // Prim: each round adds the best-supported link from the tree to a map not
+  // Prim: each round adds the most clearly singled-out link (lead_sigma) from the tree to a map not
   // in it yet. A fleet has tens of maps: the quadratic scan is nothing.
   for (;;) {
     const AgreedTransform* best = nullptr;
@@ -17,8 +17,8 @@ std::vector<TreeEdge> spanningTree(const std::vector<AgreedTransform>& agreed, c
       const bool has_target = in.count(t.target) > 0, has_source = in.count(t.source) > 0;
       if (has_target == has_source) continue;  // both inside (a cycle) or both outside (not reachable yet)
       const std::string& outside = has_target ? t.source : t.target;
-      if (!best || t.support > best->support ||
-          (t.support == best->support && outside < (target_inside ? best->source : best->target))) {
+      if (!best || t.lead_sigma > best->lead_sigma ||
+          (t.lead_sigma == best->lead_sigma && outside < (target_inside ? best->source : best->target))) {
         best = &t;
         target_inside = has_target;
       }

@@ -22,8 +22,8 @@ struct TreeEdge {
 };
 
 /// The reliable transforms among `agreed` that tie the most maps to `root`,
-/// each map through its best-supported link (a maximum spanning tree by
-/// support, grown from the root; ties go to the lower ids). Maps with no
+/// each map through its most clearly singled-out link (a maximum spanning
+/// tree by lead_sigma, grown from the root; ties go to the lower ids). Maps with no
 /// reliable path to the root are left out. Parents come before children.
 std::vector<TreeEdge> spanningTree(const std::vector<AgreedTransform>& agreed, const std::string& root);
 

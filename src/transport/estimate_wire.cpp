@@ -9,6 +9,8 @@ namespace tomomap::transport {
 namespace {
 /// Longest reason the wire type carries (string<128>), with room to spare.
 constexpr size_t kReasonChars = 120;
+/// Longest search name the wire type carries (string<16>).
+constexpr size_t kAnsweredByChars = 16;
 }  // namespace
 
 wire::TransformEstimate toWire(const AgreedTransform& t) {
@@ -29,10 +31,8 @@ wire::TransformEstimate toWire(const AgreedTransform& t) {
     for (int col = 0; col < 4; ++col) e.matrix()[static_cast<size_t>(4 * row + col)] = M(row, col);
   e.target_up({t.target_up.x(), t.target_up.y(), t.target_up.z()});
   e.source_up({t.source_up.x(), t.source_up.y(), t.source_up.z()});
-  e.support(t.support);
-  e.runner_up_support(t.runner_up_support);
-  e.inliers(t.inliers);
-  e.spread(t.spread);
+  e.answered_by(t.answered_by.substr(0, kAnsweredByChars));
+  e.lead_sigma(t.lead_sigma);
   e.computed_by(t.computed_by);
   e.computed_at_ms(t.computed_at_ms);
   e.seconds(t.seconds);
@@ -43,6 +43,8 @@ Rejection fromWire(const wire::TransformEstimate& e, AgreedTransform& t) {
   if (e.target().to_string() >= e.source().to_string()) return {Reject::UnorderedPair};
   for (double v : {e.x(), e.y(), e.z(), e.yaw()})
     if (!std::isfinite(v)) return {Reject::NonFiniteTransform};
+  if (!std::isfinite(e.lead_sigma()) || e.lead_sigma() < 0 || !fromName(e.answered_by().to_string()))
+    return {Reject::BadQuality};
   Eigen::Matrix4d M;
   for (int row = 0; row < 4; ++row)
     for (int col = 0; col < 4; ++col) M(row, col) = e.matrix()[static_cast<size_t>(4 * row + col)];
@@ -62,10 +64,8 @@ Rejection fromWire(const wire::TransformEstimate& e, AgreedTransform& t) {
   t.target_up = target_up;
   t.source_up = source_up;
   t.T_target_source_6dof = M;
-  t.support = e.support();
-  t.runner_up_support = e.runner_up_support();
-  t.inliers = e.inliers();
-  t.spread = e.spread();
+  t.answered_by = e.answered_by().to_string();
+  t.lead_sigma = e.lead_sigma();
   t.computed_by = e.computed_by().to_string();
   t.computed_at_ms = e.computed_at_ms();
   t.seconds = e.seconds();

@@ -46,6 +46,8 @@ std::string Rejection::text() const {
       return "estimate with a non-finite transform";
     case Reject::NotRigid:
       return "estimate whose whole transform is not rigid";
+    case Reject::BadQuality:
+      return "estimate with a lead that is not a number >= 0 or an unknown search";
   }
   return "unknown rejection";
 }

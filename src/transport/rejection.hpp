@@ -27,7 +27,8 @@ enum class Reject {
   OverBudget,     ///< a peer's map that would take more memory than peer_memory_mb
   UnorderedPair,  ///< estimate whose target id is not below its source id
   NonFiniteTransform,
-  NotRigid,  ///< estimate whose whole transform is not a rotation and a translation
+  NotRigid,    ///< estimate whose whole transform is not a rotation and a translation
+  BadQuality,  ///< estimate: a lead that is not a number >= 0, or a search tomomap does not have
 };
 
 struct Rejection {

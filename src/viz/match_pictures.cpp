@@ -95,7 +95,7 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
   const Rigid2D T = planar(r.T_target_source);
   const int pad = 8;
   int drawn_pairs = 0;
-  for (const auto& pair : r.supporters) {
+  for (const auto& pair : r.features.supporters) {
     if (drawn_pairs >= count) break;
     const SliceFeatures* ft = findSlice(target, pair.target_slice);
     const SliceFeatures* fs = findSlice(source, pair.source_slice);
@@ -149,7 +149,7 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
   }
   if (rows.empty()) {
     // A dense answer stands on the occupancy alone: no descriptor matches lie behind it.
-    const bool dense = r.reliable && r.method == "dense";
+    const bool dense = r.reliable && r.answered_by != Candidate::From::features;
     cv::Mat none(80, 1000, CV_8UC3, colour::kWhite);
     drawText(none,
              dense ? "found by the dense search of the occupancy, not by descriptor matches: see the overlay"
@@ -160,8 +160,8 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
   cv::Mat out = stack(rows);
   cv::Mat head(40, std::max(out.cols, 1000), CV_8UC3, colour::kWhite);
   drawText(head,
-           "winning height offset " + std::to_string(r.height_offset) + " slices (" + fixed(r.T_target_source.z, 2) +
-               " m), " + std::to_string(r.support) + " agreeing slice pairs",
+           "the features' height offset " + std::to_string(r.features.height_offset) + " slices, " +
+               std::to_string(r.features.support) + " agreeing slice pairs",
            {8, 28}, 0.65, colour::kBlack, Align::Left, 2);
   return stack({head, out});
 }

@@ -31,20 +31,20 @@ void expectSameAnswer(const MapFeatures& target, const MapFeatures& source, Matc
   const MatchResult all = matchFeatures(target, source, params);
   params.exhaustive = false;
   const MatchResult indexed = matchFeatures(target, source, params);
-  tally.indexed += indexed.slice_pairs;
-  tally.exhaustive += all.slice_pairs;
+  tally.indexed += indexed.features.slice_pairs;
+  tally.exhaustive += all.features.slice_pairs;
   ++tally.cases;
   ASSERT_EQ(indexed.reliable, all.reliable)
       << what << ": indexed '" << indexed.reason << "', exhaustive '" << all.reason << "'";
-  EXPECT_EQ(indexed.method, all.method) << what;
+  EXPECT_EQ(indexed.answered_by, all.answered_by) << what;
   if (!all.reliable) return;
   if (indexed.height_offset != all.height_offset)
-    std::cout << what << ": indexed offset " << indexed.height_offset << " support " << indexed.support
-              << " (runner-up " << indexed.runner_up_support << " at " << indexed.runner_up_offset
-              << "), exhaustive offset " << all.height_offset << " support " << all.support << " (runner-up "
-              << all.runner_up_support << " at " << all.runner_up_offset << ")\n";
+    std::cout << what << ": indexed offset " << indexed.height_offset << " support " << indexed.features.support
+              << " (runner-up " << indexed.features.runner_up_support << " at " << indexed.features.runner_up_offset
+              << "), exhaustive offset " << all.height_offset << " support " << all.features.support << " (runner-up "
+              << all.features.runner_up_support << " at " << all.features.runner_up_offset << ")\n";
   EXPECT_EQ(indexed.height_offset, all.height_offset) << what;
-  EXPECT_EQ(indexed.support, all.support) << what;
+  EXPECT_EQ(indexed.features.support, all.features.support) << what;
   const PoseError e = poseError(indexed.T_target_source, all.T_target_source);
   EXPECT_LT(e.translation, 0.001) << what;
   EXPECT_LT(e.yaw, 0.0005) << what;

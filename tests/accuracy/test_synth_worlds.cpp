@@ -92,17 +92,37 @@ RoomMatch matchRoom(uint64_t seed, const char* noise, double grid) {
 
 std::string wrongAnswer(const RoomMatch& m) {
   std::ostringstream out;
-  out << "answered wrong: " << m.error.translation << " m, " << m.error.yaw << " rad off (support " << m.result.support
-      << " vs " << m.result.runner_up_support << ", dense lead " << m.result.dense_lead << ")";
+  out << "answered wrong: " << m.error.translation << " m, " << m.error.yaw << " rad off (by "
+      << fromName(m.result.answered_by) << ", features " << m.result.features.support << " vs "
+      << m.result.features.runner_up_support << ", dense lead " << m.result.dense.at_grid_lead << ")";
   return out.str();
 }
 
-/// Expects `m` answered right at `grid` by `method` ("features" or "dense");
-/// `what` names the pair in the messages.
-void expectAnsweredRightBy(const RoomMatch& m, double grid, const std::string& method, const std::string& what) {
-  EXPECT_TRUE(m.result.reliable && m.right(grid))
-      << what << ": " << m.result.reason << " " << m.error.translation << " m off (" << m.result.method << ")";
-  EXPECT_EQ(m.result.method, method) << what;
+/// Whether any dense search ran and found a pose.
+bool searchedDensely(const MatchResult& r) {
+  return r.dense.at_grid_lead > 0 || r.dense.wide_lead > 0 || r.dense.pooled_lead > 0;
+}
+
+/// The lead of the dense search that answered (0 for a feature answer).
+double answeringLead(const MatchResult& r) {
+  switch (r.answered_by) {
+    case Candidate::From::search_at_grid:
+      return r.dense.at_grid_lead;
+    case Candidate::From::search_wide:
+      return r.dense.wide_lead;
+    case Candidate::From::search_pooled:
+      return r.dense.pooled_lead;
+    default:
+      return 0;
+  }
+}
+
+/// Expects `m` answered right at `grid`, by a dense search (`dense`) or by
+/// the features; `what` names the pair in the messages.
+void expectAnsweredRightBy(const RoomMatch& m, double grid, bool dense, const std::string& what) {
+  EXPECT_TRUE(m.result.reliable && m.right(grid)) << what << ": " << m.result.reason << " " << m.error.translation
+                                                  << " m off (by " << fromName(m.result.answered_by) << ")";
+  EXPECT_EQ(m.result.answered_by != Candidate::From::features, dense) << what;
 }
 
 // Small rooms (under 32 slices at g 0.1, partial overlap): the features alone
@@ -127,7 +147,8 @@ TEST(SmallRooms, SucceedLikeTallMapsAtTheirGridAndAreNeverAnsweredWrong) {
       const bool ok = m.right(grid);
       (r.reliable ? (ok ? right : wrong) : refused)++;
       std::cout << "room seed " << seed << " " << noise << " g " << grid << ": "
-                << (r.reliable ? (ok ? "right" : "WRONG") + (" by " + r.method) : "no reliable match: " + r.reason)
+                << (r.reliable ? (ok ? "right" : "WRONG") + (" by " + std::string(fromName(r.answered_by)))
+                             : "no reliable match: " + r.reason)
                 << "\n";
     }
     std::cout << noise << " noise, g " << grid << ": " << right << " right, " << refused << " refused, " << wrong
@@ -147,15 +168,15 @@ TEST(SmallRooms, EmptySpaceTheOtherMapSawTellsARoomFromItsHalfTurn) {
   int looked_again = 0;
   for (const uint64_t seed : {2, 3, 6}) {
     const RoomMatch m = matchRoom(seed, "high", 0.1);
-    expectAnsweredRightBy(m, 0.1, "dense", "seed " + std::to_string(seed));
-    EXPECT_GE(m.result.dense_lead, 1.4) << "seed " << seed;
-    EXPECT_EQ(m.result.dense_pooled_lead, 0.0) << "seed " << seed << ": not the grid's search alone";
+    expectAnsweredRightBy(m, 0.1, true, "seed " + std::to_string(seed));
+    EXPECT_GE(answeringLead(m.result), 1.4) << "seed " << seed;
+    EXPECT_EQ(m.result.dense.pooled_lead, 0.0) << "seed " << seed << ": not the grid's search alone";
     // The grid's search answering alone had a second look, the maps' roles
     // swapped, and it put the source's origin within two looks' tolerance
     // (sqrt(2) x 5 cells); the wide search's answer (seed 3) had the features'.
-    if (!m.result.dense_second_look_apart) continue;
+    if (!m.result.dense.second_look_apart) continue;
     ++looked_again;
-    EXPECT_LE(*m.result.dense_second_look_apart, std::sqrt(2.0) * 5 * 0.1) << "seed " << seed;
+    EXPECT_LE(*m.result.dense.second_look_apart, std::sqrt(2.0) * 5 * 0.1) << "seed " << seed;
   }
   EXPECT_GE(looked_again, 1) << "no answer had a second look";
 }
@@ -176,7 +197,7 @@ TEST(SmallRooms, APoseThatContradictsWhatTheOtherMapSawEmptyDoesNotAnswer) {
 // skipped the dense check. A weak winner is checked however far it leads.
 TEST(SmallRooms, AWeakFeatureWinnerIsCheckedDenselyHoweverFarItLeads) {
   const RoomMatch m = matchRoom(8, "none", 0.05);
-  EXPECT_GT(m.result.dense_lead, 0.0) << "the dense search did not run";
+  EXPECT_TRUE(searchedDensely(m.result)) << "the dense search did not run";
   EXPECT_FALSE(m.answeredWrong(0.05)) << wrongAnswer(m);
 }
 
@@ -201,11 +222,11 @@ TEST(SmallRooms, ADenseSearchShortOfAnsweringStillRefusesAFeatureAnswerItContrad
 TEST(SmallRooms, AFeatureAnswerTheDenseSearchDoesNotConfirmIsRefused) {
   for (const uint64_t seed : {11, 93, 108, 112, 177}) {
     const RoomMatch m = matchRoom(seed, "high", 0.05);
-    EXPECT_GT(m.result.dense_lead, 0.0) << "seed " << seed << ": the dense search did not run";
+    EXPECT_TRUE(searchedDensely(m.result)) << "seed " << seed << ": the dense search did not run";
     EXPECT_FALSE(m.answeredWrong(0.05)) << "seed " << seed << " " << wrongAnswer(m);
   }
   const RoomMatch confirmed = matchRoom(122, "high", 0.05);
-  expectAnsweredRightBy(confirmed, 0.05, "features", "seed 122");
+  expectAnsweredRightBy(confirmed, 0.05, false, "seed 122");
 }
 
 // A narrow feature winner for a half-turned room is not the answer. Seed 150
@@ -217,7 +238,7 @@ TEST(SmallRooms, AFeatureAnswerTheDenseSearchDoesNotConfirmIsRefused) {
 TEST(SmallRooms, ANarrowFeatureWinnerForAHalfTurnedRoomIsNotTheAnswer) {
   const RoomMatch m = matchRoom(150, "high", 0.1);
   EXPECT_TRUE(m.result.reliable && m.right(0.1))
-      << m.result.reason << " " << m.error.translation << " m off (" << m.result.method << ")";
+      << m.result.reason << " " << m.error.translation << " m off (by " << fromName(m.result.answered_by) << ")";
 }
 
 // At g 0.05 a room's 5 cm of wall noise splits its walls across neighbouring
@@ -229,8 +250,8 @@ TEST(SmallRooms, ANarrowFeatureWinnerForAHalfTurnedRoomIsNotTheAnswer) {
 TEST(SmallRooms, WhereTheGridLeavesARoomRefusedPooledOccupancyAnswersIt) {
   for (const auto& [seed, noise] : {std::pair<uint64_t, const char*>{3, "low"}, {10, "high"}}) {
     const RoomMatch m = matchRoom(seed, noise, 0.05);
-    expectAnsweredRightBy(m, 0.05, "dense", "seed " + std::to_string(seed) + " " + noise);
-    EXPECT_NEAR(m.result.dense_cell, 0.1, 1e-9) << "seed " << seed << ": not the pooled search's answer";
+    expectAnsweredRightBy(m, 0.05, true, "seed " + std::to_string(seed) + " " + noise);
+    EXPECT_EQ(m.result.answered_by, Candidate::From::search_pooled) << "seed " << seed << ": not the pooled search's answer";
   }
 }
 
@@ -243,9 +264,9 @@ TEST(SmallRooms, WhereTheGridLeavesARoomRefusedPooledOccupancyAnswersIt) {
 // g 0.1, has both searches on one wrong pose, at 1.11x and 1.02x: refused.
 TEST(SmallRooms, TwoSearchesShortOfAnsweringAnswerWhereTheyAgree) {
   const RoomMatch agreed = matchRoom(23, "low", 0.05);
-  expectAnsweredRightBy(agreed, 0.05, "dense", "seed 23");
-  EXPECT_GE(agreed.result.dense_wide_lead, 1.2) << "the wide search confirmed it";
-  EXPECT_LT(agreed.result.dense_wide_lead, 1.4) << "a lead that would answer alone";
+  expectAnsweredRightBy(agreed, 0.05, true, "seed 23");
+  EXPECT_GE(agreed.result.dense.wide_lead, 1.2) << "the wide search confirmed it";
+  EXPECT_LT(agreed.result.dense.wide_lead, 1.4) << "a lead that would answer alone";
   const RoomMatch m = matchRoom(11, "low", 0.1);
   EXPECT_FALSE(m.result.reliable) << wrongAnswer(m);
 }

@@ -51,11 +51,11 @@ int main(int argc, char** argv) {
     recalled.push_back(secondsOf([&] { b = matchFeatures(target, after, p, {}, &cache); }));
   }
   const bool same = a.reliable == b.reliable && a.T_target_source.x == b.T_target_source.x &&
-                    a.T_target_source.yaw == b.T_target_source.yaw && a.support == b.support;
+                    a.T_target_source.yaw == b.T_target_source.yaw && a.features.support == b.features.support;
   std::printf(
       "re-match after a cabinet, g %.2f, median of %d: from scratch %.3f s, recalling %.3f s (%zu of %zu "
       "slice pairs recalled, %s answer)\n",
-      p.grid, runs, quantile(fresh, 0.5), quantile(recalled, 0.5), b.slice_pairs_recalled, b.slice_pairs,
+      p.grid, runs, quantile(fresh, 0.5), quantile(recalled, 0.5), b.features.slice_pairs_recalled, b.features.slice_pairs,
       same ? "the same" : "A DIFFERENT");
   return same ? 0 : 1;
 }

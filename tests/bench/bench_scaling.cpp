@@ -55,14 +55,14 @@ int main(int argc, char** argv) {
       a.push_back(ra.timings.pair_matching);
       b.push_back(rb.timings.pair_matching);
     }
-    same = same && ra.reliable == rb.reliable && ra.height_offset == rb.height_offset && ra.support == rb.support;
+    same = same && ra.reliable == rb.reliable && ra.height_offset == rb.height_offset && ra.features.support == rb.features.support;
     const double slices = (t.slice_count + s.slice_count) / 2.0;
     fast.x.push_back(slices), fast.y.push_back(quantile(a, 0.5));
     slow.x.push_back(slices), slow.y.push_back(quantile(b, 0.5));
     std::printf("%5.0f slices, %4.0f features a slice: indexed %.3f s (%zu of %zu pairs), every pair %.3f s\n", slices,
                 static_cast<double>(t.featureCount() + s.featureCount()) /
                     static_cast<double>(t.slices.size() + s.slices.size()),
-                quantile(a, 0.5), ra.slice_pairs, ra.slice_pairs_total, quantile(b, 0.5));
+                quantile(a, 0.5), ra.features.slice_pairs, ra.features.slice_pairs_total, quantile(b, 0.5));
   }
   const double k_fast = viz::logLogSlope(fast.x, fast.y), k_slow = viz::logLogSlope(slow.x, slow.y);
   std::printf("log-log slope: indexed %.2f, every pair %.2f (medians of %d; %s answers)\n", k_fast, k_slow, runs,

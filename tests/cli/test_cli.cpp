@@ -66,7 +66,8 @@ TEST(Cli, MatchDemoRoomPrintsTransformErrorAndJson) {
   EXPECT_NEAR(j["T_target_source"]["yaw"].get<double>(), -3.087, 0.02);
   EXPECT_EQ(j["T_target_source"]["matrix"].size(), 4u);
   EXPECT_TRUE(j["error"]["success"].get<bool>());
-  EXPECT_GT(j["quality"]["support"].get<int>(), 3);
+  EXPECT_GT(j["features"]["support"].get<int>(), 3);
+  EXPECT_GT(j["lead_sigma"].get<double>(), 3.0) << "a clear answer, as the pose graph weighs it";
 }
 
 TEST(Cli, MissingFile) { expectBadInput(runTomomap("match /nonexistent/a.pcd /nonexistent/b.pcd"), "no such file"); }
@@ -226,7 +227,8 @@ TEST(Cli, OneThreadOrTwoGiveTheSameAnswerSaidInTheSameOrder) {
     answer[threads - 1] = nlohmann::json::parse(in);
   }
   EXPECT_EQ(answer[0]["T_target_source"], answer[1]["T_target_source"]);
-  EXPECT_EQ(answer[0]["quality"], answer[1]["quality"]);
+  EXPECT_EQ(answer[0]["features"], answer[1]["features"]);
+  EXPECT_EQ(answer[0]["lead_sigma"], answer[1]["lead_sigma"]);
   EXPECT_EQ(answer[0]["target_points"], answer[1]["target_points"]);
 
   // Both maps bad: the target is named, as when they are read in turn.

@@ -262,7 +262,8 @@ TEST(Identity, AHundredThousandFuzzedSamplesCrashNothingAndLeaveMemoryFlat) {
         e.reliable(any(2));
         e.x(anyDouble());
         e.yaw(anyDouble());
-        e.support(static_cast<int32_t>(any(0)));
+        e.answered_by(any(2) ? "features" : "no such search");
+        e.lead_sigma(anyDouble());
         e.computed_by("bravo");
         fuzzer.bus->publish(e);
         break;

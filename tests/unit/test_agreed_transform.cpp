@@ -1,6 +1,8 @@
 // One agreed-transform type: to JSON and back, to the wire and back.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "results/agreed_transform.hpp"
 #include "transport/estimate_wire.hpp"
 
@@ -16,10 +18,8 @@ AgreedTransform sample() {
   t.source_version = 42;
   t.reliable = true;
   t.T_target_source = {1.25, -2.5, 0.05, -3.0};
-  t.support = 30;
-  t.runner_up_support = 18;
-  t.inliers = 437;
-  t.spread = {1.5, 2.0, 0.7};
+  t.answered_by = "search_pooled";
+  t.lead_sigma = 7.25;
   t.computed_by = "bravo";
   t.computed_at_ms = 1763800000123;
   t.seconds = 0.75;
@@ -50,6 +50,17 @@ TEST(AgreedTransform, JsonRoundTrip) {
   broken = j;
   broken["target_version"] = "xyz";
   EXPECT_THROW(agreedFromJson(broken), InputError);
+
+  broken = j;
+  broken["quality"]["lead_sigma"] = -2.0;
+  EXPECT_THROW(agreedFromJson(broken), InputError);
+  broken = j;
+  broken["quality"]["answered_by"] = "guesswork";
+  EXPECT_THROW(agreedFromJson(broken), InputError);
+  // A file of schema 2 weighed its pairs by slice pairs: read as the least clear.
+  nlohmann::json schema2 = j;
+  schema2["quality"] = {{"support", 30}, {"runner_up_support", 18}, {"inliers", 437}, {"inlier_spread", {1, 2, 0.7}}};
+  EXPECT_EQ(agreedFromJson(schema2).lead_sigma, 0.0);
 
   // A file written before maps were levelled in the fleet: level maps, 4-DoF.
   nlohmann::json before = j;
@@ -104,4 +115,13 @@ TEST(AgreedTransform, WireRoundTripAndChecks) {
   wire::TransformEstimate nan = e;
   nan.yaw(std::nan(""));
   EXPECT_EQ(transport::fromWire(nan, back), transport::Reject::NonFiniteTransform);
+  // The pose graph weighs a pair by its lead: a forged one must not be.
+  for (const double lead : {std::nan(""), -1.0, HUGE_VAL}) {
+    wire::TransformEstimate forged = e;
+    forged.lead_sigma(lead);
+    EXPECT_EQ(transport::fromWire(forged, back), transport::Reject::BadQuality) << lead;
+  }
+  wire::TransformEstimate unknown = e;
+  unknown.answered_by("guesswork");
+  EXPECT_EQ(transport::fromWire(unknown, back), transport::Reject::BadQuality);
 }

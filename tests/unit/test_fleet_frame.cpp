@@ -21,13 +21,13 @@ const std::map<std::string, Pose4> kWorld{{"alpha", {0, 0, 0, 0}},
 
 /// The agreed transform of a pair as a good match gives it: the truth, off by
 /// a few millimetres and a tenth of a degree.
-AgreedTransform pair(const std::string& t, const std::string& s, std::mt19937& rng, int support = 20) {
+AgreedTransform pair(const std::string& t, const std::string& s, std::mt19937& rng, double lead_sigma = 20) {
   std::normal_distribution<double> mm(0, 0.004), rad(0, 0.001);
   AgreedTransform a;
   a.target = t;
   a.source = s;
   a.reliable = true;
-  a.support = support;
+  a.lead_sigma = lead_sigma;
   a.T_target_source = kWorld.at(t).inverse() * kWorld.at(s);
   a.T_target_source.x += mm(rng);
   a.T_target_source.y += mm(rng);
@@ -80,14 +80,14 @@ TEST(FleetFrame, EveryAgentIsPlacedInTheReferencesMapAndEveryPairOnALoopIsConsis
 TEST(FleetFrame, OneWrongPairIsFlaggedInconsistentAndLeftOut) {
   std::mt19937 rng(2);
   // Each of the six pairs in turn matched a look-alike place: 1.5 m and 30
-  // degrees off, once with the support of the others and once with more
-  // support than any right pair.
+  // degrees off, once as clear as the others and once clearer
+  // than any right pair.
   for (size_t wrong = 0; wrong < 6; ++wrong)
     for (const bool strongest : {false, true}) {
       auto pairs = allPairs(kFour, rng);
       pairs[wrong].T_target_source.x += 1.5;
       pairs[wrong].T_target_source.yaw += radians(30);
-      if (strongest) pairs[wrong].support = 60;
+      if (strongest) pairs[wrong].lead_sigma = 60;
       const PairKey bad = pairs[wrong].pair();
       const FleetFrame frame = buildFleetFrame(pairs, kFour, "alpha", kLimits);
       const PairVerdict* v = frame.verdict(bad);
@@ -123,13 +123,13 @@ TEST(FleetFrame, PairsOnNoLoopAreUncheckedAndAgentsWithoutAPathUnreachable) {
             std::vector<std::string>{"echo"});
 }
 
-TEST(FleetFrame, ALoopOfThreeThatMissesPutsTheLeastSupportedPairAside) {
+TEST(FleetFrame, ALoopOfThreeThatMissesPutsTheLeastClearPairAside) {
   // One loop cannot say which of its pairs is wrong: the weakest goes, and
   // the other two are left on no loop, unchecked.
   std::mt19937 rng(4);
   auto pairs = allPairs({"alpha", "bravo", "charlie"}, rng);
   pairs[2].T_target_source.x += 2.0;  // bravo<-charlie
-  pairs[2].support = 5;
+  pairs[2].lead_sigma = 5;
   const FleetFrame frame = buildFleetFrame(pairs, {"alpha", "bravo", "charlie"}, "alpha", kLimits);
   EXPECT_EQ(frame.verdict({"bravo", "charlie"})->verdict, Consistency::Inconsistent);
   EXPECT_EQ(frame.verdict({"alpha", "bravo"})->verdict, Consistency::Unchecked);

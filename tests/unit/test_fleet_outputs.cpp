@@ -26,7 +26,7 @@ AgreedTransform alphaBravo(double x) {
   t.source = "bravo";
   t.reliable = true;
   t.T_target_source = {x, 2, 0.5, 0.3};
-  t.support = 12;
+  t.lead_sigma = 12;
   t.computed_by = "alpha";
   t.computed_at_ms = 1'700'000'000'000;
   return t;

@@ -3,6 +3,7 @@
 #include <random>
 
 #include "core/matcher.hpp"
+#include "core/verdict.hpp"
 #include "support.hpp"
 #include "synth/scene.hpp"
 #include "synth/synth.hpp"
@@ -29,8 +30,9 @@ TEST(Matcher, ParallelRunEqualsSerialRun) {
   const MatchResult a = matchMaps(demo.map1, demo.map2, serial), b = matchMaps(demo.map1, demo.map2, parallel);
   EXPECT_EQ(a.T_target_source.x, b.T_target_source.x);
   EXPECT_EQ(a.T_target_source.yaw, b.T_target_source.yaw);
-  EXPECT_EQ(a.support, b.support);
-  EXPECT_EQ(a.inliers, b.inliers);
+  EXPECT_EQ(a.features.support, b.features.support);
+  EXPECT_EQ(a.features.inliers, b.features.inliers);
+  EXPECT_EQ(a.lead_sigma, b.lead_sigma);
 }
 
 TEST(Matcher, ReportsQualityAndTimings) {
@@ -38,12 +40,17 @@ TEST(Matcher, ReportsQualityAndTimings) {
   const auto demo = test::loadDemoPair();
   const MatchResult r = matchMaps(demo.map1, demo.map2, MatchParams{});
   ASSERT_TRUE(r.reliable);
-  EXPECT_GT(r.support, r.runner_up_support);
-  EXPECT_GE(r.inliers, 100u);
-  EXPECT_GT(r.inlier_spread.x(), 0.5);  // inliers spread over the room, not one corner
-  EXPECT_GT(r.inlier_spread.z(), 0.3);
-  EXPECT_GT(r.slice_pairs, 1000u);  // slices with features, all against all
-  EXPECT_LE(r.slice_pairs, static_cast<size_t>(r.target_slices) * r.source_slices);
+  const FeatureFindings& f = r.features;
+  EXPECT_GT(f.support, f.runner_up_support);
+  EXPECT_GE(f.inliers, 100u);
+  EXPECT_GT(f.inlier_spread.x(), 0.5);  // inliers spread over the room, not one corner
+  EXPECT_GT(f.inlier_spread.z(), 0.3);
+  EXPECT_GT(f.slice_pairs, 1000u);  // slices with features, all against all
+  EXPECT_LE(f.slice_pairs, static_cast<size_t>(r.target_slices) * r.source_slices);
+  // The pair's weight in a fleet: the features' lead, in standard deviations.
+  EXPECT_EQ(r.answered_by, Candidate::From::features);
+  EXPECT_GE(r.lead_sigma, significance(f.support, f.runner_up_support));
+  EXPECT_GT(r.lead_sigma, 3.0);
   EXPECT_GT(r.timings.pair_matching, 0.0);
 }
 
@@ -113,9 +120,10 @@ TEST(Matcher, ATieBetweenTwoHeightsIsNoReliableMatch) {
   Points two_floors = demo.map1;
   for (const auto& p : demo.map1) two_floors.push_back(p + Eigen::Vector3f(0, 0, 4.0f));
   const MatchResult r = matchMaps(two_floors, demo.map2, MatchParams{});
-  EXPECT_FALSE(r.reliable) << "support " << r.support << ", runner-up " << r.runner_up_support;
+  EXPECT_FALSE(r.reliable) << "support " << r.features.support << ", runner-up " << r.features.runner_up_support;
   EXPECT_NE(r.reason.find("ambiguous"), std::string::npos) << r.reason;
-  EXPECT_GT(std::abs(r.runner_up_offset - r.height_offset), 60) << "4 m apart at g 0.05";
+  EXPECT_GT(std::abs(r.features.runner_up_offset - r.features.height_offset), 60) << "4 m apart at g 0.05";
+  EXPECT_EQ(r.lead_sigma, 0.0) << "no answer, no weight";
 }
 
 namespace {

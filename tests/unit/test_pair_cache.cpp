@@ -13,10 +13,10 @@ namespace {
 void expectSameAnswer(const MatchResult& a, const MatchResult& b) {
   EXPECT_EQ(a.reliable, b.reliable);
   EXPECT_EQ(a.height_offset, b.height_offset);
-  EXPECT_EQ(a.support, b.support);
-  EXPECT_EQ(a.runner_up_support, b.runner_up_support);
-  EXPECT_EQ(a.inliers, b.inliers);
-  EXPECT_EQ(a.slice_pairs, b.slice_pairs) << "the same pairs chosen";
+  EXPECT_EQ(a.features.support, b.features.support);
+  EXPECT_EQ(a.features.runner_up_support, b.features.runner_up_support);
+  EXPECT_EQ(a.features.inliers, b.features.inliers);
+  EXPECT_EQ(a.features.slice_pairs, b.features.slice_pairs) << "the same pairs chosen";
   EXPECT_EQ(a.T_target_source.x, b.T_target_source.x);
   EXPECT_EQ(a.T_target_source.y, b.T_target_source.y);
   EXPECT_EQ(a.T_target_source.z, b.T_target_source.z);
@@ -40,21 +40,21 @@ TEST(PairCache, AMapUpdateReestimatesOnlyThePairsOfChangedSlicesAndAnswersAsAFre
 
   PairCache cache;
   const MatchResult first = matchFeatures(target, before, p, {}, &cache);
-  EXPECT_EQ(first.slice_pairs_recalled, 0u) << "nothing to recall yet";
-  EXPECT_EQ(cache.size(), first.slice_pairs);
+  EXPECT_EQ(first.features.slice_pairs_recalled, 0u) << "nothing to recall yet";
+  EXPECT_EQ(cache.size(), first.features.slice_pairs);
 
   const MatchResult update = matchFeatures(target, after, p, {}, &cache);
   const MatchResult fresh = matchFeatures(target, after, p);
   ASSERT_TRUE(fresh.reliable) << fresh.reason;
   expectSameAnswer(update, fresh);
-  EXPECT_GT(update.slice_pairs_recalled, update.slice_pairs / 2) << "most slices did not change";
+  EXPECT_GT(update.features.slice_pairs_recalled, update.features.slice_pairs / 2) << "most slices did not change";
   // Every pair whose source slice changed was matched again.
-  EXPECT_LE(update.slice_pairs_recalled, target.slices.size() * (after.slices.size() - changed));
+  EXPECT_LE(update.features.slice_pairs_recalled, target.slices.size() * (after.slices.size() - changed));
   std::printf("%zu of %zu source slices changed: %zu of %zu slice pairs recalled\n", changed, after.slices.size(),
-              update.slice_pairs_recalled, update.slice_pairs);
+              update.features.slice_pairs_recalled, update.features.slice_pairs);
 
   const MatchResult again = matchFeatures(target, after, p, {}, &cache);
-  EXPECT_EQ(again.slice_pairs_recalled, again.slice_pairs) << "nothing changed";
+  EXPECT_EQ(again.features.slice_pairs_recalled, again.features.slice_pairs) << "nothing changed";
   expectSameAnswer(again, fresh);
 }
 
@@ -67,7 +67,7 @@ TEST(PairCache, OutcomesFromOtherSettingsAreNotRecalled) {
   matchFeatures(target, source, p, {}, &cache);
   p.ransac_threshold_cells = 2.0;
   const MatchResult other = matchFeatures(target, source, p, {}, &cache);
-  EXPECT_EQ(other.slice_pairs_recalled, 0u);
+  EXPECT_EQ(other.features.slice_pairs_recalled, 0u);
   expectSameAnswer(other, matchFeatures(target, source, p));
 }
 

@@ -7,20 +7,20 @@ using namespace tomomap;
 
 namespace {
 
-AgreedTransform link(const std::string& target, const std::string& source, int support, bool reliable = true) {
+AgreedTransform link(const std::string& target, const std::string& source, int lead, bool reliable = true) {
   AgreedTransform t;
   t.target = target;
   t.source = source;
-  t.support = support;
+  t.lead_sigma = lead;
   t.reliable = reliable;
-  t.T_target_source = {1.0 * support, 2.0, 0.5, 0.3};
-  t.computed_at_ms = 1000u * static_cast<uint64_t>(support);
+  t.T_target_source = {1.0 * lead, 2.0, 0.5, 0.3};
+  t.computed_at_ms = 1000u * static_cast<uint64_t>(lead);
   return t;
 }
 
 }  // namespace
 
-TEST(TfTree, EachMapHangsFromTheTreeByItsBestSupportedReliableLink) {
+TEST(TfTree, EachMapHangsFromTheTreeByItsClearestReliableLink) {
   const std::vector<AgreedTransform> agreed{link("a", "b", 10), link("b", "c", 20), link("a", "c", 5),
                                             link("a", "d", 40, /*reliable=*/false)};
   const auto tree = spanningTree(agreed, "a");
