@@ -234,6 +234,13 @@ nlohmann::json candidatesJson(const MatchResult& r, const std::vector<std::optio
     for (const SliceLanding& s : c.slices)
       if (s.cells > 0) slices.push_back({s.slice, s.cells, s.telling, s.seen, s.on, s.telling_on, s.contradicted});
     j["slices"] = slices;
+    if (!c.pooled_slices.empty()) {
+      nlohmann::json pooled = nlohmann::json::array();
+      for (const SliceLanding& s : c.pooled_slices)
+        if (s.cells > 0) pooled.push_back({s.slice, s.cells, s.telling, s.seen, s.on, s.telling_on, s.contradicted});
+      j["pooled_slices"] = pooled;
+    }
+    if (c.feature_votes >= 0) j["feature_votes"] = c.feature_votes;
     if (checks[i])
       j["error"] = {{"translation", checks[i]->error.translation},
                     {"yaw", checks[i]->error.yaw},

@@ -1,6 +1,7 @@
 #include "candidates.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "height_offsets.hpp"
 #include "nearby_poses.hpp"
@@ -12,14 +13,27 @@ namespace {
 /// Places climbed at most: each climb lands thousands of poses.
 constexpr size_t kMostClimbs = 4;
 
-/// `out` with each candidate's landing, slice by slice, and its whole transform.
+/// A height offset in slices as an offset in slices pooled by two.
+int pooledOffset(int offset) { return static_cast<int>(std::floor(offset / 2.0 + 0.5)); }
+
+/// `out` with each candidate's landing, slice by slice (and on pooled
+/// occupancy for fine maps), its feature votes and its whole transform.
 std::vector<Candidate> finished(std::vector<Candidate> out, const MapFeatures& target, const MapFeatures& source,
-                                const DenseSearchParams& dp) {
-  std::vector<std::pair<Rigid2D, int>> poses;
-  for (const Candidate& c : out) poses.emplace_back(c.landed.transform, c.landed.offset);
+                                const DenseSearchParams& dp, const FeatureVotes& votes) {
+  std::vector<std::pair<Rigid2D, int>> poses, pooled_poses;
+  for (const Candidate& c : out) {
+    poses.emplace_back(c.landed.transform, c.landed.offset);
+    pooled_poses.emplace_back(c.landed.transform, pooledOffset(c.landed.offset));
+  }
   std::vector<std::vector<SliceLanding>> slices = landSlices(target.occupancy, source.occupancy, poses, dp);
+  std::vector<std::vector<SliceLanding>> pooled_slices;
+  if (target.grid < dp.finest_empty_cell - 1e-9)
+    pooled_slices = landSlices(pooled(fullSlices(target.occupancy)), pooled(fullSlices(source.occupancy)),
+                               pooled_poses, dp);
   for (size_t i = 0; i < out.size(); ++i) {
     if (i < slices.size()) out[i].slices = std::move(slices[i]);
+    if (i < pooled_slices.size()) out[i].pooled_slices = std::move(pooled_slices[i]);
+    if (votes) out[i].feature_votes = votes(out[i].landed.transform, out[i].landed.offset);
     out[i].T_own_frames = betweenOwnFrames(poseAt(out[i].landed.transform, out[i].landed.offset, target, source).matrix(),
                                            target.slicedUp(), source.slicedUp());
   }
@@ -53,7 +67,8 @@ std::optional<Candidate::From> fromName(const std::string& name) {
 }
 
 std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeatures& source,
-                                     const std::vector<Proposal>& proposals, const MatchParams& params) {
+                                     const std::vector<Proposal>& proposals, const MatchParams& params,
+                                     const FeatureVotes& votes) {
   if (target.occupancy.partial || source.occupancy.partial || proposals.empty()) return {};
   DenseSearchParams dp;
   dp.threads = matchThreads(params);
@@ -65,13 +80,17 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
   std::vector<Candidate> out;
   for (size_t i = 0; i < proposals.size(); ++i) {
     const Proposal& p = proposals[i];
-    out.push_back({p.from, p.rank, p.feature_support, p.T, p.offset, as_proposed[i], as_proposed[i], {}, Eigen::Matrix4d::Identity()});
+    Candidate c;
+    c.from = p.from, c.rank = p.rank, c.feature_support = p.feature_support;
+    c.proposed = p.T, c.proposed_offset = p.offset;
+    c.proposed_landed = c.landed = as_proposed[i];
+    out.push_back(std::move(c));
   }
   // The best distinct places as proposed climb (small maps: on a large one
   // a climb takes seconds); two proposals are one place within looksApart
   // at the source's centre and the smear of heights.
   if (!denseSearchable(target.occupancy) || !denseSearchable(source.occupancy))
-    return finished(std::move(out), target, source, dp);
+    return finished(std::move(out), target, source, dp, votes);
   std::vector<size_t> order(out.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
@@ -92,7 +111,7 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
     climbed.push_back(i);
     c.landed = uphill(land, target.occupancy, source.occupancy, c.proposed, c.proposed_offset, dp);
   }
-  return finished(std::move(out), target, source, dp);
+  return finished(std::move(out), target, source, dp, votes);
 }
 
 }  // namespace tomomap

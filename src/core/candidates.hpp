@@ -1,6 +1,7 @@
 #pragma once
 // Candidate poses: what every search proposes, each refined and scored the
 // same way on the two maps' occupancy (docs/algorithm.md, "Candidates").
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,6 +23,14 @@ struct Candidate {
   DensePose proposed_landed;  ///< the proposal landed as it is
   DensePose landed;           ///< refined (uphill, where it climbed) and landed
   std::vector<SliceLanding> slices;  ///< `landed`, source slice by source slice
+  /// `landed` on the occupancy pooled to twice the cell, slice by slice
+  /// (pooled slices), for maps finer than DenseSearchParams::finest_empty_cell:
+  /// the empty space their own cells do not read. Empty otherwise.
+  std::vector<SliceLanding> pooled_slices;
+  /// Slice-pair estimates of the features that agree with `landed` (within
+  /// the consensus tolerances, at its height within half the smear); -1 where
+  /// the features gave none to count.
+  int feature_votes = -1;
   /// `landed` as the whole transform between the maps' own frames (as
   /// MatchResult::matrix() gives the answer's).
   Eigen::Matrix4d T_own_frames = Eigen::Matrix4d::Identity();
@@ -30,6 +39,9 @@ struct Candidate {
 const char* fromName(Candidate::From from);
 /// The inverse: the search a name names; empty for any other text.
 std::optional<Candidate::From> fromName(const std::string& name);
+
+/// How many of the features' slice-pair estimates agree with a pose (T, offset).
+using FeatureVotes = std::function<int(const Rigid2D&, int)>;
 
 /// A proposal: a pose, its height offset, where it came from.
 struct Proposal {
@@ -45,6 +57,7 @@ struct Proposal {
 /// kMostClimbs best distinct places climb uphill (nearby_poses.hpp), the rest
 /// stay as proposed. Empty where either map's occupancy is partial.
 std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeatures& source,
-                                     const std::vector<Proposal>& proposals, const MatchParams& params);
+                                     const std::vector<Proposal>& proposals, const MatchParams& params,
+                                     const FeatureVotes& votes = {});
 
 }  // namespace tomomap

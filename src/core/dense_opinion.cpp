@@ -185,7 +185,7 @@ void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Propos
       for (size_t i = 0; i < (*o)->search.poses.size() && i < kProposalsPerSearch; ++i)
         proposals.push_back(
             {from, static_cast<int>(i), 0, (*o)->search.poses[i].transform, (*o)->search.poses[i].offset});
-  r.candidates = refineAndLand(target, source, proposals, params);
+  r.candidates = refineAndLand(target, source, proposals, params, e.feature_votes);
 }
 
 }  // namespace

@@ -165,6 +165,9 @@ struct Evidence {
   /// The features' distinct answers after the winner (rival_answers.hpp), as
   /// proposals: gathered for MatchParams::candidates alone, not weighed here.
   std::vector<Proposal> feature_rivals;
+  /// The features' slice-pair estimates that agree with a pose: for
+  /// MatchParams::candidates alone.
+  FeatureVotes feature_votes;
 };
 
 struct Verdict {
