@@ -240,7 +240,12 @@ nlohmann::json candidatesJson(const MatchResult& r, const std::vector<std::optio
         if (s.cells > 0) pooled.push_back({s.slice, s.cells, s.telling, s.seen, s.on, s.telling_on, s.contradicted});
       j["pooled_slices"] = pooled;
     }
-    if (c.feature_votes >= 0) j["feature_votes"] = c.feature_votes;
+    if (!c.feature_votes.empty()) {
+      nlohmann::json votes = nlohmann::json::array();
+      for (size_t k = 0; k < c.feature_votes.size(); ++k)
+        if (c.feature_votes[k] > 0) votes.push_back({k, c.feature_votes[k]});
+      j["feature_votes"] = votes;
+    }
     if (checks[i])
       j["error"] = {{"translation", checks[i]->error.translation},
                     {"yaw", checks[i]->error.yaw},

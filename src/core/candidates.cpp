@@ -28,8 +28,7 @@ std::vector<Candidate> finished(std::vector<Candidate> out, const MapFeatures& t
   std::vector<std::vector<SliceLanding>> slices = landSlices(target.occupancy, source.occupancy, poses, dp);
   std::vector<std::vector<SliceLanding>> pooled_slices;
   if (target.grid < dp.finest_empty_cell - 1e-9)
-    pooled_slices = landSlices(pooled(fullSlices(target.occupancy)), pooled(fullSlices(source.occupancy)),
-                               pooled_poses, dp);
+    pooled_slices = landSlices(pooled(target.occupancy), pooled(source.occupancy), pooled_poses, dp);
   for (size_t i = 0; i < out.size(); ++i) {
     if (i < slices.size()) out[i].slices = std::move(slices[i]);
     if (i < pooled_slices.size()) out[i].pooled_slices = std::move(pooled_slices[i]);

@@ -28,9 +28,9 @@ struct Candidate {
   /// the empty space their own cells do not read. Empty otherwise.
   std::vector<SliceLanding> pooled_slices;
   /// Slice-pair estimates of the features that agree with `landed` (within
-  /// the consensus tolerances, at its height within half the smear); -1 where
-  /// the features gave none to count.
-  int feature_votes = -1;
+  /// the consensus tolerances, at its height within half the smear), by
+  /// source slice index; empty where the features gave none to count.
+  std::vector<int> feature_votes;
   /// `landed` as the whole transform between the maps' own frames (as
   /// MatchResult::matrix() gives the answer's).
   Eigen::Matrix4d T_own_frames = Eigen::Matrix4d::Identity();
@@ -40,8 +40,9 @@ const char* fromName(Candidate::From from);
 /// The inverse: the search a name names; empty for any other text.
 std::optional<Candidate::From> fromName(const std::string& name);
 
-/// How many of the features' slice-pair estimates agree with a pose (T, offset).
-using FeatureVotes = std::function<int(const Rigid2D&, int)>;
+/// How many of the features' slice-pair estimates agree with a pose (T,
+/// offset), by source slice index.
+using FeatureVotes = std::function<std::vector<int>(const Rigid2D&, int)>;
 
 /// A proposal: a pose, its height offset, where it came from.
 struct Proposal {

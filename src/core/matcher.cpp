@@ -98,16 +98,23 @@ void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const 
   f.support = static_cast<int>(best.consensus.support());
   f.height_offset = best.offset;
   if (params.candidates) {
-    // Every slice pair's estimate with its height offset, for the candidates' votes.
-    std::vector<std::pair<int, Rigid2D>> estimates;
+    // Every slice pair's estimate with its source slice and height offset, for the candidates' votes.
+    struct Vote {
+      int source_slice, offset;
+      Rigid2D T;
+    };
+    std::vector<Vote> estimates;
     for (size_t k = 0; k < pairs.estimates.size(); ++k)
       if (pairs.matched[k] && pairs.estimates[k].ok)
-        estimates.emplace_back(target.slices[k / ns].index - source.slices[k % ns].index, pairs.estimates[k].T);
+        estimates.push_back({source.slices[k % ns].index,
+                             target.slices[k / ns].index - source.slices[k % ns].index, pairs.estimates[k].T});
     ev.feature_votes = [estimates = std::move(estimates), same = consensusParams(params, target.grid),
-                        centre = source.centre()](const Rigid2D& T, int offset) {
-      return static_cast<int>(std::count_if(estimates.begin(), estimates.end(), [&](const auto& est) {
-        return std::abs(est.first - offset) <= kSmearSlices / 2 && agree(est.second, T, same, centre);
-      }));
+                        centre = source.centre(), n = source.occupancy.size()](const Rigid2D& T, int offset) {
+      std::vector<int> by_slice(static_cast<size_t>(n), 0);
+      for (const Vote& v : estimates)
+        if (v.source_slice < n && std::abs(v.offset - offset) <= kSmearSlices / 2 && agree(v.T, T, same, centre))
+          ++by_slice[static_cast<size_t>(v.source_slice)];
+      return by_slice;
     };
     int rank = 0;
     for (const OffsetScore& a : distinctAnswers(pairs, target, source, params))
