@@ -10,7 +10,7 @@ PACKAGES=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   cyclonedds-dev cyclonedds-tools  # the tests' ROS 2 node: a second DDS vendor, rmw_cyclonedds's
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
-  libssl-dev liblzf-dev
+  libssl-dev liblzf-dev libboost-dev  # Boost.Math: the t and normal distributions
   libgtest-dev libgmock-dev libbenchmark-dev libsystemd-dev zlib1g-dev libpng-dev
   python3 time
   file dpkg-dev systemd  # CPack's .deb dependency scan; systemd-analyze checks the unit in the tests

@@ -43,6 +43,9 @@ struct Row {
          peak_rss_mb = 0;
   double features = 0, slices = 0, payload_bytes = 0, raw_bytes = 0;
   std::string note;
+  /// With --candidates: what the decision over them (on trial) gives, "right",
+  /// "wrong" or "refused"; empty where it did not run.
+  std::string candidate_decision;
 };
 
 const char* kCsvHeader =
@@ -122,6 +125,15 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
     row.success = j["error"]["success"];
   }
   if (!row.reliable) row.note = j.value("reason", "");
+  if (j.contains("candidate_decision")) {
+    const auto& answer = j["candidate_decision"]["answer"];
+    row.candidate_decision =
+        answer.is_null() ? "refused"
+                         : j["candidates"].at(answer.get<size_t>()).value("error", nlohmann::json::object()).value(
+                               "success", false)
+                               ? "right"
+                               : "wrong";
+  }
   const auto& s = j["slices"];
   row.features = s.value("target_features", 0.0) + s.value("source_features", 0.0);
   row.slices = s.value("target", 0.0) + s.value("source", 0.0);
@@ -179,6 +191,25 @@ std::string summary(const std::string& suite, const std::vector<Row>& rows, cons
   for (const auto& [key, f] : families)
     o << "| " << key.first << " | " << key.second << " | " << f[0] + f[1] + f[2] + f[3] << " | " << f[0] << " | "
       << f[1] << " | " << f[2] << " | " << f[3] << " |\n";
+  // With --candidates: the decision over them, on trial, beside the answers.
+  std::map<std::string, std::array<int, 4>> trial;  // the verdict's right; the trial's right, refused, wrong
+  for (const auto& r : rows)
+    if (!r.candidate_decision.empty()) {
+      auto& t = trial[r.family];
+      t[0] += r.success;
+      ++t[r.candidate_decision == "right" ? 1 : r.candidate_decision == "refused" ? 2 : 3];
+    }
+  if (!trial.empty()) {
+    o << "\nOne decision over the candidates, on trial (docs/algorithm.md; a candidate is judged at its 4-DoF "
+         "pose, before the 6-DoF finish):\n\n| family | the answers right | on trial: right | refused | wrong "
+         "|\n|---|---|---|---|---|\n";
+    std::array<int, 4> sum{};
+    for (const auto& [family, t] : trial) {
+      o << "| " << family << " | " << t[0] << " | " << t[1] << " | " << t[2] << " | " << t[3] << " |\n";
+      for (size_t i = 0; i < 4; ++i) sum[i] += t[i];
+    }
+    o << "| all | " << sum[0] << " | " << sum[1] << " | " << sum[2] << " | " << sum[3] << " |\n";
+  }
   if (!skipped.empty()) {
     o << "\nSkipped (no pair to match, not counted above):\n";
     for (const auto& s : skipped) o << "- " << s << "\n";
@@ -386,7 +417,10 @@ int runEval(const EvalOptions& o) {
                                   {"features", r.features},
                                   {"feature_payload_bytes", r.payload_bytes},
                                   {"raw_map_bytes", r.raw_bytes},
-                                  {"note", r.note}}
+                                  {"note", r.note},
+                                  {"candidate_decision", r.candidate_decision.empty()
+                                                             ? nlohmann::json()
+                                                             : nlohmann::json(r.candidate_decision)}}
                        .dump()
                 << std::endl;
       std::cerr << "[" << rows.size() << "/" << total << "] " << std::left << std::setw(28) << p.name << " "

@@ -277,6 +277,14 @@ void printCandidates(std::ostream& out, const MatchResult& r,
                     checks[i]->success() ? "right" : "wrong");
     out << "\n";
   }
+  if (!r.candidate_verdict) return;
+  const CandidateVerdict& v = *r.candidate_verdict;
+  if (v.answer < 0)
+    out << "one decision     (on trial, not the answer) no reliable match: " << v.reason << "\n";
+  else
+    out << format("one decision     (on trial, not the answer) %s (%d), %.1f sigma clear on %s over %d slices\n",
+                  fromName(r.candidates[static_cast<size_t>(v.answer)].from),
+                  r.candidates[static_cast<size_t>(v.answer)].rank, v.lead_sigma, onName(v.on), v.slices);
 }
 
 }  // namespace
@@ -301,6 +309,14 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
     j["grid"] = grid;
     if (extra.is_object()) j.update(extra);
     if (!r.candidates.empty()) j["candidates"] = candidatesJson(r, checks);
+    if (r.candidate_verdict) {
+      const CandidateVerdict& v = *r.candidate_verdict;
+      j["candidate_decision"] = {{"answer", v.answer >= 0 ? nlohmann::json(v.answer) : nlohmann::json()},
+                                 {"on", onName(v.on)},
+                                 {"lead_sigma", v.lead_sigma},
+                                 {"slices", v.slices}};
+      if (v.answer < 0) j["candidate_decision"]["reason"] = v.reason;
+    }
     if (json_to_stdout) {
       std::cout << j.dump(2) << "\n";
     } else {

@@ -186,6 +186,7 @@ void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Propos
         proposals.push_back(
             {from, static_cast<int>(i), 0, (*o)->search.poses[i].transform, (*o)->search.poses[i].offset});
   r.candidates = refineAndLand(target, source, proposals, params, e.feature_votes);
+  r.candidate_verdict = decideOnCandidates(r.candidates, params, target.grid, source.occupancy.grid.centre());
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <optional>
 #include <string>
 
+#include "candidate_decision.hpp"
 #include "candidates.hpp"
 #include "match_params.hpp"
 #include "rigid2d.hpp"
@@ -104,6 +105,9 @@ struct MatchResult {
   /// With MatchParams::candidates: every candidate pose the searches
   /// proposed, refined and landed (candidates.hpp).
   std::vector<Candidate> candidates;
+  /// With MatchParams::candidates: the decision over them, on trial beside
+  /// the verdict (candidate_decision.hpp); it changes no answer.
+  std::optional<CandidateVerdict> candidate_verdict;
 };
 
 /// Finds T_target_source from two feature stacks of the same grid size: slice

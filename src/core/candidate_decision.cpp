@@ -1,0 +1,161 @@
+#include "candidate_decision.hpp"
+
+#include <algorithm>
+#include <boost/math/distributions/normal.hpp>
+#include <boost/math/distributions/students_t.hpp>
+#include <cmath>
+#include <map>
+
+#include "height_offsets.hpp"
+#include "text.hpp"
+
+namespace tomomap {
+namespace {
+
+/// A lead whose chance probability is below double's range reads as this many sigmas.
+constexpr double kMostSigma = 37.0;
+
+/// Per slice: what a candidate lands there (telling cells less twice those in
+/// space the target saw empty) and its telling cells.
+using SliceScores = std::map<int, std::pair<double, double>>;
+
+SliceScores occupancyBySlice(const Candidate& c) {
+  SliceScores out;
+  for (const SliceLanding& s : c.pooled_slices.empty() ? c.slices : c.pooled_slices)
+    if (s.telling > 0) out[s.slice] = {s.telling_on - 2.0 * s.contradicted, s.telling};
+  return out;
+}
+
+double total(const SliceScores& s) {
+  double sum = 0;
+  for (const auto& [slice, v] : s) sum += v.first;
+  return sum;
+}
+
+int votes(const Candidate& c) {
+  int sum = 0;
+  for (int v : c.feature_votes) sum += v;
+  return sum;
+}
+
+/// `a`'s lead over `b` on the occupancy, slice by slice: each slice's
+/// difference per telling cell (the larger of the two), so that every slice
+/// weighs alike whatever its size.
+std::pair<double, int> occupancyLead(const SliceScores& a, const SliceScores& b) {
+  std::map<int, double> diff;
+  for (const auto& [k, v] : a) diff[k] = 0;
+  for (const auto& [k, v] : b) diff[k] = 0;
+  std::vector<double> d;
+  for (const auto& [k, unused] : diff) {
+    const auto ia = a.find(k), ib = b.find(k);
+    const std::pair<double, double> va = ia == a.end() ? std::pair{0.0, 0.0} : ia->second;
+    const std::pair<double, double> vb = ib == b.end() ? std::pair{0.0, 0.0} : ib->second;
+    d.push_back((va.first - vb.first) / std::max({va.second, vb.second, 1.0}));
+  }
+  return {pairedLeadSigma(d), static_cast<int>(d.size())};
+}
+
+/// `a`'s lead over `b` in slice-pair estimates agreeing, over the source
+/// slices where either has one.
+std::pair<double, int> votesLead(const Candidate& a, const Candidate& b) {
+  std::vector<double> d;
+  const size_t n = std::max(a.feature_votes.size(), b.feature_votes.size());
+  for (size_t k = 0; k < n; ++k) {
+    const int va = k < a.feature_votes.size() ? a.feature_votes[k] : 0;
+    const int vb = k < b.feature_votes.size() ? b.feature_votes[k] : 0;
+    if (va > 0 || vb > 0) d.push_back(va - vb);
+  }
+  return {pairedLeadSigma(d), static_cast<int>(d.size())};
+}
+
+}  // namespace
+
+const char* onName(CandidateVerdict::On on) {
+  return on == CandidateVerdict::On::occupancy ? "occupancy" : "feature_votes";
+}
+
+double pairedLeadSigma(const std::vector<double>& differences) {
+  const size_t n = differences.size();
+  if (n < 2) return 0.0;
+  double mean = 0;
+  for (double x : differences) mean += x;
+  mean /= static_cast<double>(n);
+  if (mean <= 0) return 0.0;
+  double ss = 0;
+  for (double x : differences) ss += (x - mean) * (x - mean);
+  const double se = std::sqrt(ss / static_cast<double>(n - 1) / static_cast<double>(n));
+  if (se <= 0) return kMostSigma;
+  const double tail = boost::math::cdf(
+      boost::math::complement(boost::math::students_t(static_cast<double>(n - 1)), mean / se));
+  if (!(tail > 1e-300)) return kMostSigma;
+  return std::min(kMostSigma, boost::math::quantile(boost::math::complement(boost::math::normal(), tail)));
+}
+
+CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, const MatchParams& params, double grid,
+                                    const Eigen::Vector2d& source_centre) {
+  CandidateVerdict v;
+  if (candidates.empty()) {
+    v.reason = "no candidate pose";
+    return v;
+  }
+  const ConsensusParams tolerance = consensusParams(params, grid);
+  const auto samePlace = [&](const Candidate& a, const Candidate& b) {
+    return std::abs(a.landed.offset - b.landed.offset) <= kSmearSlices / 2 &&
+           agree(a.landed.transform, b.landed.transform, tolerance, source_centre);
+  };
+  std::vector<SliceScores> scores;
+  for (const Candidate& c : candidates) scores.push_back(occupancyBySlice(c));
+  // The best of those not at `at`'s place, by `better`; -1 if every one is there.
+  const auto bestElsewhere = [&](size_t at, const auto& better) {
+    int out = -1;
+    for (size_t i = 0; i < candidates.size(); ++i)
+      if (!samePlace(candidates[i], candidates[at]) && (out < 0 || better(i, static_cast<size_t>(out))))
+        out = static_cast<int>(i);
+    return out;
+  };
+  const auto lands_more = [&](size_t a, size_t b) { return total(scores[a]) > total(scores[b]); };
+  const auto agreed_more = [&](size_t a, size_t b) { return votes(candidates[a]) > votes(candidates[b]); };
+
+  size_t best = 0;
+  for (size_t i = 1; i < candidates.size(); ++i)
+    if (lands_more(i, best)) best = i;
+  const int rival = bestElsewhere(best, lands_more);
+  std::pair<double, int> lead{0.0, 0};
+  if (rival >= 0) lead = occupancyLead(scores[best], scores[static_cast<size_t>(rival)]);
+  if (lead.first >= kClearSigma) {
+    v.answer = static_cast<int>(best);
+    v.lead_sigma = lead.first, v.slices = lead.second;
+    return v;
+  }
+  v.reason = rival < 0 ? "no candidate elsewhere to weigh the best against"
+                       : "the candidate that lands the most leads the best elsewhere by " + fixed(lead.first, 1) +
+                             " sigma over " + std::to_string(lead.second) + " slices (need " +
+                             fixed(kClearSigma, 0) + ")";
+
+  // The features' evidence, where the occupancy does not tell (a street's
+  // poses along its facades land alike): answered only where the occupancy
+  // does not tell against it.
+  size_t voted = 0;
+  for (size_t i = 1; i < candidates.size(); ++i)
+    if (agreed_more(i, voted)) voted = i;
+  if (votes(candidates[voted]) == 0) return v;
+  const int other = bestElsewhere(voted, agreed_more);
+  if (other < 0) return v;
+  const std::pair<double, int> by_votes = votesLead(candidates[voted], candidates[static_cast<size_t>(other)]);
+  v.reason += "; the candidate most slice pairs agree with leads the most agreed-with elsewhere by " +
+              fixed(by_votes.first, 1) + " sigma over " + std::to_string(by_votes.second) + " source slices";
+  if (by_votes.first < kClearSigma) return v;
+  for (size_t i = 0; i < candidates.size(); ++i)
+    if (!samePlace(candidates[i], candidates[voted]) && lands_more(i, voted) &&
+        occupancyLead(scores[i], scores[voted]).first >= kClearSigma) {
+      v.reason += ", but a candidate elsewhere lands more, beyond chance";
+      return v;
+    }
+  v.answer = static_cast<int>(voted);
+  v.on = CandidateVerdict::On::feature_votes;
+  v.lead_sigma = by_votes.first, v.slices = by_votes.second;
+  v.reason.clear();
+  return v;
+}
+
+}  // namespace tomomap

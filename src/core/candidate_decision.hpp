@@ -1,0 +1,51 @@
+#pragma once
+// One decision over the candidates, on trial beside the verdict (verdict.hpp)
+// until it answers the regression matrix as well: the best candidate answers
+// when its lead over the best candidate elsewhere, slice by slice, is beyond
+// chance (docs/algorithm.md, "One decision, on trial").
+#include <string>
+#include <vector>
+
+#include "candidates.hpp"
+
+namespace tomomap {
+
+/// The one bar: a lead counts when chance alone would give it less often than
+/// a normal variable exceeds this many standard deviations (one-sided, 0.13 %).
+/// On the matrix's 316 pairs no answer was wrong from 3 (docs/results.md,
+/// "Candidates on the matrix"); it is not tuned below that.
+inline constexpr double kClearSigma = 3.0;
+
+/// What the decision over the candidates says.
+struct CandidateVerdict {
+  int answer = -1;  ///< index into the candidates; -1: no reliable match
+  /// The evidence it answered on: the occupancy the candidate lands on, or,
+  /// where that does not tell, the features' slice-pair estimates it agrees with.
+  enum class On { occupancy, feature_votes } on = On::occupancy;
+  double lead_sigma = 0;  ///< the answer's lead over the best candidate elsewhere [normal sigmas]
+  int slices = 0;         ///< the slices it was measured over
+  std::string reason;     ///< why there is no answer
+};
+
+const char* onName(CandidateVerdict::On on);
+
+/// How far the mean of `differences` (one per slice) lies above zero, by a
+/// one-sided Student t test over them, as the normal deviate of the same
+/// tail probability: a lead over 3 slices counts for less than the same
+/// t over 50. 0 for fewer than two differences or a mean at or below zero.
+double pairedLeadSigma(const std::vector<double>& differences);
+
+/// The decision over `candidates` (refineAndLand's, for maps of `grid` whose
+/// source raster is centred at `source_centre`). Two candidates are at the same
+/// place within one consensus tolerance at that centre, the consensus yaw and
+/// half the smear of heights. The candidate that lands the most (telling
+/// cells less twice the contradicted ones, slice by slice, on occupancy pooled
+/// to DenseSearchParams::finest_empty_cell where the grid is finer) answers if
+/// it leads the best candidate elsewhere by kClearSigma over the slices; else
+/// the one the most slice-pair estimates agree with answers if it leads the
+/// most agreed-with elsewhere by kClearSigma, source slice by source slice,
+/// and no candidate elsewhere lands kClearSigma more.
+CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, const MatchParams& params, double grid,
+                                    const Eigen::Vector2d& source_centre);
+
+}  // namespace tomomap

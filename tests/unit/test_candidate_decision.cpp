@@ -1,0 +1,96 @@
+#include <gtest/gtest.h>
+
+#include "core/candidate_decision.hpp"
+
+using namespace tomomap;
+
+namespace {
+
+/// A candidate at (x, y, yaw) whose source slices 0..n-1 each land `on`
+/// telling cells of `telling` and contradict `contradicted`.
+Candidate landing(double x, double y, double yaw, int n, const std::vector<uint32_t>& on, uint32_t telling = 100,
+                  uint32_t contradicted = 0) {
+  Candidate c;
+  c.landed.transform = Rigid2D{yaw, Eigen::Vector2d(x, y)};
+  for (int k = 0; k < n; ++k) {
+    SliceLanding s;
+    s.slice = k;
+    s.cells = s.telling = telling;
+    s.on = s.telling_on = on[static_cast<size_t>(k) % on.size()];
+    s.contradicted = contradicted;
+    c.slices.push_back(s);
+  }
+  return c;
+}
+
+MatchParams atTenCentimetres() { return MatchParams{}; }
+
+}  // namespace
+
+TEST(CandidateDecision, ALeadCountsByItsSlicesSpreadAndNumber) {
+  EXPECT_EQ(pairedLeadSigma({}), 0.0);
+  EXPECT_EQ(pairedLeadSigma({5.0}), 0.0) << "one slice says nothing of chance";
+  EXPECT_EQ(pairedLeadSigma({-1, -2, -3}), 0.0);
+  EXPECT_GT(pairedLeadSigma({2, 2, 2, 2}), 30.0) << "the same lead on every slice";
+  // The same t (3.4-3.5) over 3 slices and over 50: the few count for less.
+  const double few = pairedLeadSigma({1.0, 2.0, 3.0});  // t = 2 / (1 / sqrt 3) = 3.46, 2 degrees of freedom
+  EXPECT_NEAR(few, 1.79, 0.02);                          // tail 3.7 %
+  std::vector<double> spread;
+  for (int k = 0; k < 50; ++k) spread.push_back(k % 2 ? 2.0 + 4.08 : 2.0 - 4.08);
+  EXPECT_NEAR(pairedLeadSigma(spread), 3.23, 0.02);  // t = 3.43, 49 degrees of freedom
+}
+
+TEST(CandidateDecision, TheBestAnswersWhereItLeadsEveryPlaceElsewhereBeyondChance) {
+  const MatchParams p = atTenCentimetres();
+  std::vector<Candidate> c{landing(0, 0, 0, 20, {60, 70, 65}), landing(5, 0, 0, 20, {30, 20, 25}),
+                           // within one tolerance (5 cells, 0.5 m) of the best: the same place, not a rival
+                           landing(0.3, 0, 0, 20, {58, 71, 66})};
+  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero());
+  ASSERT_EQ(v.answer, 0) << v.reason;
+  EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
+  EXPECT_GE(v.lead_sigma, kClearSigma);
+  EXPECT_EQ(v.slices, 20);
+}
+
+TEST(CandidateDecision, TwoPlacesThatLandAlikeAreNoAnswer) {
+  const MatchParams p = atTenCentimetres();
+  std::vector<Candidate> c{landing(0, 0, 0, 20, {60, 50, 70}), landing(0, 0, 3.1, 20, {55, 65, 58})};
+  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero());
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_NE(v.reason.find("sigma over 20 slices (need 3)"), std::string::npos) << v.reason;
+  // One candidate alone has nothing to be clear of.
+  const CandidateVerdict alone = decideOnCandidates({c[0]}, p, 0.1, Eigen::Vector2d::Zero());
+  EXPECT_EQ(alone.answer, -1);
+  EXPECT_NE(alone.reason.find("no candidate elsewhere"), std::string::npos) << alone.reason;
+  EXPECT_EQ(decideOnCandidates({}, p, 0.1, Eigen::Vector2d::Zero()).answer, -1);
+}
+
+TEST(CandidateDecision, WhereTheOccupancyDoesNotTellTheFeaturesVotesDoUnlessItTellsAgainstThem) {
+  const MatchParams p = atTenCentimetres();
+  // A street: two poses 3 m apart along the facades land alike; the slice
+  // pairs agree with the second on every slice.
+  Candidate along = landing(3, 0, 0, 20, {60, 50, 70}), right = landing(0, 0, 0, 20, {55, 65, 58});
+  along.feature_votes.assign(20, 0);
+  right.feature_votes.assign(20, 0);
+  for (size_t k = 0; k < 20; ++k) {
+    right.feature_votes[k] = 3 + static_cast<int>(k % 2);
+    along.feature_votes[k] = k % 3 == 0 ? 1 : 0;
+  }
+  CandidateVerdict v = decideOnCandidates({along, right}, p, 0.1, Eigen::Vector2d::Zero());
+  ASSERT_EQ(v.answer, 1) << v.reason;
+  EXPECT_EQ(v.on, CandidateVerdict::On::feature_votes);
+  EXPECT_GE(v.lead_sigma, kClearSigma);
+  // A third pose elsewhere that lands far more, slice by slice, tells against them.
+  const Candidate clear = landing(-6, 2, 1.0, 20, {95, 90, 97});
+  v = decideOnCandidates({along, right, clear}, p, 0.1, Eigen::Vector2d::Zero());
+  EXPECT_EQ(v.answer, 2) << "the occupancy's clear best answers first: " << v.reason;
+  EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
+}
+
+TEST(CandidateDecision, EmptySpaceTheOtherMapSawCountsAgainstAPose) {
+  const MatchParams p = atTenCentimetres();
+  // The half-turned room lands more cells but twice as many of its cells in space the target saw empty.
+  std::vector<Candidate> c{landing(0, 0, 3.1, 20, {80, 85, 82}, 100, 30), landing(0, 0, 0, 20, {60, 62, 61}, 100, 0)};
+  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero());
+  EXPECT_EQ(v.answer, 1) << v.reason;
+}
