@@ -314,6 +314,12 @@ TEST(Cli, CandidatesListEveryProposedPoseScoredWithItsError) {
   for (const char* search : {"features", "search_at_grid", "search_wide", "search_pooled"})
     EXPECT_TRUE(from.count(search)) << search << " proposed nothing\n" << r.output;
   EXPECT_TRUE(best_right) << "on this room the best-scoring candidate is the right pose\n" << r.output;
+  // The decision on trial answers a right candidate here, clear beyond chance, and says so.
+  const auto& trial = j["candidate_decision"];
+  ASSERT_FALSE(trial["answer"].is_null()) << trial.dump();
+  EXPECT_TRUE(j["candidates"].at(trial["answer"].get<size_t>())["error"]["success"].get<bool>()) << trial.dump();
+  EXPECT_GE(trial["lead_sigma"].get<double>(), 3.0);
+  EXPECT_NE(r.output.find("one decision     (on trial, not the answer)"), std::string::npos) << r.output;
   const auto plain = runTomomap("match " + w + "/map_0.pcd " + w + "/map_1.pcd --grid 0.1 --json " + (dir / "p.json"));
   EXPECT_FALSE(nlohmann::json::parse(std::ifstream(dir / "p.json")).contains("candidates")) << "only when asked";
 }
