@@ -117,12 +117,15 @@ double answeringLead(const MatchResult& r) {
   }
 }
 
-/// Expects `m` answered right at `grid`, by a dense search (`dense`) or by
-/// the features; `what` names the pair in the messages.
-void expectAnsweredRightBy(const RoomMatch& m, double grid, bool dense, const std::string& what) {
+/// Which kind of search answered.
+enum class By { features, dense_search };
+
+/// Expects `m` answered right at `grid` by `by`; `what` names the pair in the messages.
+void expectAnsweredRightBy(const RoomMatch& m, double grid, By by, const std::string& what) {
   EXPECT_TRUE(m.result.reliable && m.right(grid)) << what << ": " << m.result.reason << " " << m.error.translation
                                                   << " m off (by " << fromName(m.result.answered_by) << ")";
-  EXPECT_EQ(m.result.answered_by != Candidate::From::features, dense) << what;
+  EXPECT_EQ(m.result.answered_by == Candidate::From::features ? By::features : By::dense_search, by)
+      << what << ": by " << fromName(m.result.answered_by);
 }
 
 // Small rooms (under 32 slices at g 0.1, partial overlap), seeds 1-10 at low
@@ -142,7 +145,7 @@ TEST(SmallRooms, EmptySpaceTheOtherMapSawTellsARoomFromItsHalfTurn) {
   int looked_again = 0;
   for (const uint64_t seed : {2, 3, 6}) {
     const RoomMatch m = matchRoom(seed, "high", 0.1);
-    expectAnsweredRightBy(m, 0.1, true, "seed " + std::to_string(seed));
+    expectAnsweredRightBy(m, 0.1, By::dense_search, "seed " + std::to_string(seed));
     EXPECT_GE(answeringLead(m.result), 1.4) << "seed " << seed;
     EXPECT_EQ(m.result.dense.pooled_lead, 0.0) << "seed " << seed << ": not the grid's search alone";
     // The grid's search answering alone had a second look, the maps' roles
@@ -200,7 +203,7 @@ TEST(SmallRooms, AFeatureAnswerTheDenseSearchDoesNotConfirmIsRefused) {
     EXPECT_FALSE(m.answeredWrong(0.05)) << "seed " << seed << " " << wrongAnswer(m);
   }
   const RoomMatch confirmed = matchRoom(122, "high", 0.05);
-  expectAnsweredRightBy(confirmed, 0.05, false, "seed 122");
+  expectAnsweredRightBy(confirmed, 0.05, By::features, "seed 122");
 }
 
 // A narrow feature winner for a half-turned room is not the answer. Seed 150
@@ -224,7 +227,7 @@ TEST(SmallRooms, ANarrowFeatureWinnerForAHalfTurnedRoomIsNotTheAnswer) {
 TEST(SmallRooms, WhereTheGridLeavesARoomRefusedPooledOccupancyAnswersIt) {
   for (const auto& [seed, noise] : {std::pair<uint64_t, const char*>{3, "low"}, {10, "high"}}) {
     const RoomMatch m = matchRoom(seed, noise, 0.05);
-    expectAnsweredRightBy(m, 0.05, true, "seed " + std::to_string(seed) + " " + noise);
+    expectAnsweredRightBy(m, 0.05, By::dense_search, "seed " + std::to_string(seed) + " " + noise);
     EXPECT_EQ(m.result.answered_by, Candidate::From::search_pooled) << "seed " << seed << ": not the pooled search's answer";
   }
 }
@@ -238,7 +241,7 @@ TEST(SmallRooms, WhereTheGridLeavesARoomRefusedPooledOccupancyAnswersIt) {
 // g 0.1, has both searches on one wrong pose, at 1.11x and 1.02x: refused.
 TEST(SmallRooms, TwoSearchesShortOfAnsweringAnswerWhereTheyAgree) {
   const RoomMatch agreed = matchRoom(23, "low", 0.05);
-  expectAnsweredRightBy(agreed, 0.05, true, "seed 23");
+  expectAnsweredRightBy(agreed, 0.05, By::dense_search, "seed 23");
   EXPECT_GE(agreed.result.dense.wide_lead, 1.2) << "the wide search confirmed it";
   EXPECT_LT(agreed.result.dense.wide_lead, 1.4) << "a lead that would answer alone";
   const RoomMatch m = matchRoom(11, "low", 0.1);
@@ -261,7 +264,7 @@ TEST(SmallRooms, APooledSearchDoesNotConfirmAFeatureAnswer) {
 // of it in height) against a 0.25 m limit.
 TEST(SmallRooms, AnAnswerTakesTheHeightWhereTheOccupancyMeetsBest) {
   const RoomMatch m = matchRoom(111, "high", 0.05);
-  expectAnsweredRightBy(m, 0.05, "features", "seed 111");
+  expectAnsweredRightBy(m, 0.05, By::features, "seed 111");
   EXPECT_LT(m.error.translation, 0.1) << "yaw error " << m.error.yaw;
 }
 
@@ -276,7 +279,7 @@ TEST(SmallRooms, AnAnswerTakesTheHeightWhereTheOccupancyMeetsBest) {
 TEST(SmallMaps, AFeatureAnswerWhosePoseHoldsStandsWhereTheDenseSearchFoundNone) {
   for (const uint64_t seed : {1, 4}) {
     const RoomMatch m = matchWorld(WorldType::Indoor, seed, "low", 0.2);
-    expectAnsweredRightBy(m, 0.2, "features", "building seed " + std::to_string(seed));
+    expectAnsweredRightBy(m, 0.2, By::features, "building seed " + std::to_string(seed));
   }
 }
 
@@ -287,6 +290,6 @@ TEST(SmallMaps, ACopyOneRoomAlongLosesToTheRightPoseOnTheOccupancy) {
   // runs into space the other map saw empty.
   for (const uint64_t seed : {2, 3, 5}) {
     const RoomMatch m = matchWorld(WorldType::Indoor, seed, "low", 0.2);
-    expectAnsweredRightBy(m, 0.2, "features", "building seed " + std::to_string(seed));
+    expectAnsweredRightBy(m, 0.2, By::features, "building seed " + std::to_string(seed));
   }
 }
