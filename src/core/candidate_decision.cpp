@@ -100,8 +100,7 @@ CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, co
   }
   const ConsensusParams tolerance = consensusParams(params, grid);
   const auto samePlace = [&](const Candidate& a, const Candidate& b) {
-    return std::abs(a.landed.offset - b.landed.offset) <= kSmearSlices / 2 &&
-           agree(a.landed.transform, b.landed.transform, tolerance, source_centre);
+    return onePlace(a.landed.transform, a.landed.offset, b.landed.transform, b.landed.offset, tolerance, source_centre);
   };
   std::vector<SliceScores> scores;
   for (const Candidate& c : candidates) scores.push_back(occupancyBySlice(c));

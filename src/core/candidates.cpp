@@ -103,8 +103,7 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
     if (climbed.size() == kMostClimbs) break;
     Candidate& c = out[i];
     const bool seen = std::any_of(climbed.begin(), climbed.end(), [&](size_t k) {
-      return std::abs(out[k].proposed_offset - c.proposed_offset) <= kSmearSlices / 2 &&
-             agree(out[k].proposed, c.proposed, same, centre);
+      return onePlace(out[k].proposed, out[k].proposed_offset, c.proposed, c.proposed_offset, same, centre);
     });
     if (seen) continue;
     climbed.push_back(i);

@@ -62,8 +62,7 @@ Opinion searchAt(const MapFeatures& target, const MapFeatures& source, const Sli
 /// same place at the source's centre, within the smear of height offsets (a
 /// pooled offset is a whole number of pooled slices: up to pooling - 1 more).
 bool isBestPose(const Opinion& o, const Rigid2D& a, int offset, const MapFeatures& source) {
-  return std::abs(o.best().offset - offset) <= kSmearSlices / 2 + o.pooling - 1 &&
-         agree(a, o.best().transform, o.same, source.centre());
+  return onePlace(a, offset, o.best().transform, o.best().offset, o.same, source.centre(), o.pooling - 1);
 }
 
 /// The verdict's view of an opinion, its best pose against the features'
@@ -130,8 +129,7 @@ void climbUphill(MatchResult& r, const std::vector<std::pair<Rigid2D, int>>& fou
   same.translation_tolerance = looksApart(params, target.grid);
   std::vector<std::pair<Rigid2D, int>> starts{{answer, r.height_offset}};
   for (const auto& [T, offset] : found)
-    if (std::abs(offset - r.height_offset) <= kSmearSlices / 2 &&
-        agree(T, answer, same, source.occupancy.grid.centre()))
+    if (onePlace(T, offset, answer, r.height_offset, same, source.occupancy.grid.centre()))
       starts.emplace_back(T, offset);
   // One preparation of the occupancy lands the starts and serves the climb.
   const PoseLander land = poseLander(target.occupancy, source.occupancy, dp);

@@ -1,6 +1,7 @@
 #pragma once
 // Steps 2 and 3 of matching (docs/algorithm.md): the consensus of
 // the slice-pair estimates at every height offset, and the winning offset.
+#include <cstdlib>
 #include <vector>
 
 #include "consensus.hpp"
@@ -33,6 +34,15 @@ std::vector<OffsetScore> scoreOffsets(const SlicePairTable& table, const MapFeat
 /// winner's own transform is that alignment smeared over height (walls look
 /// alike a few slices up or down), not another answer.
 constexpr int kSmearSlices = 10;
+
+/// Whether two poses, each at its height offset [slices], are one place:
+/// `same` accepts their transforms at `pivot`, and their offsets lie within
+/// half the smear of heights, and `slack` slices more (an offset counted in
+/// pooled slices is a whole number of them).
+inline bool onePlace(const Rigid2D& a, int a_offset, const Rigid2D& b, int b_offset, const ConsensusParams& same,
+                     const Eigen::Vector2d& pivot, int slack = 0) {
+  return std::abs(a_offset - b_offset) <= kSmearSlices / 2 + slack && agree(a, b, same, pivot);
+}
 
 struct OffsetChoice {
   const OffsetScore* best = nullptr;  ///< most support, then most inliers; null when there are no scores

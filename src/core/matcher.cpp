@@ -112,7 +112,7 @@ void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const 
                         centre = source.centre(), n = source.occupancy.size()](const Rigid2D& T, int offset) {
       std::vector<int> by_slice(static_cast<size_t>(n), 0);
       for (const Vote& v : estimates)
-        if (v.source_slice < n && std::abs(v.offset - offset) <= kSmearSlices / 2 && agree(v.T, T, same, centre))
+        if (v.source_slice < n && onePlace(v.T, v.offset, T, offset, same, centre))
           ++by_slice[static_cast<size_t>(v.source_slice)];
       return by_slice;
     };
