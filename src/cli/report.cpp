@@ -221,6 +221,14 @@ nlohmann::json landedJson(const DensePose& p) {
           {"slices_seen", p.support_seen}};
 }
 
+/// A landing slice by slice, the slices with cells: [slice, cells, telling, seen, on, telling_on, contradicted].
+nlohmann::json slicesJson(const std::vector<SliceLanding>& slices) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const SliceLanding& s : slices)
+    if (s.cells > 0) out.push_back({s.slice, s.cells, s.telling, s.seen, s.on, s.telling_on, s.contradicted});
+  return out;
+}
+
 nlohmann::json candidatesJson(const MatchResult& r, const std::vector<std::optional<GroundTruthCheck>>& checks) {
   nlohmann::json out = nlohmann::json::array();
   for (size_t i = 0; i < r.candidates.size(); ++i) {
@@ -230,16 +238,8 @@ nlohmann::json candidatesJson(const MatchResult& r, const std::vector<std::optio
                      {"feature_support", c.feature_support},
                      {"proposed", landedJson(c.proposed_landed)},
                      {"refined", landedJson(c.landed)}};
-    nlohmann::json slices = nlohmann::json::array();
-    for (const SliceLanding& s : c.slices)
-      if (s.cells > 0) slices.push_back({s.slice, s.cells, s.telling, s.seen, s.on, s.telling_on, s.contradicted});
-    j["slices"] = slices;
-    if (!c.pooled_slices.empty()) {
-      nlohmann::json pooled = nlohmann::json::array();
-      for (const SliceLanding& s : c.pooled_slices)
-        if (s.cells > 0) pooled.push_back({s.slice, s.cells, s.telling, s.seen, s.on, s.telling_on, s.contradicted});
-      j["pooled_slices"] = pooled;
-    }
+    j["slices"] = slicesJson(c.slices);
+    if (!c.pooled_slices.empty()) j["pooled_slices"] = slicesJson(c.pooled_slices);
     if (!c.feature_votes.empty()) {
       nlohmann::json votes = nlohmann::json::array();
       for (size_t k = 0; k < c.feature_votes.size(); ++k)
