@@ -72,6 +72,10 @@ nlohmann::json toJson(const Pose4& T) {
   return {{"x", T.x}, {"y", T.y}, {"z", T.z}, {"yaw", T.yaw}, {"matrix", matrixJson(T.matrix())}};
 }
 
+bool plausibleQuality(const std::string& answered_by, double lead_sigma) {
+  return std::isfinite(lead_sigma) && lead_sigma >= 0 && fromName(answered_by).has_value();
+}
+
 nlohmann::json toJson(const AgreedTransform& t) {
   nlohmann::json j{{"target", t.target},
                    {"source", t.source},
@@ -120,8 +124,9 @@ AgreedTransform agreedFromJson(const nlohmann::json& j) {
     const auto& q = j.at("quality");
     t.answered_by = q.value("answered_by", fromName(Candidate::From::features));
     t.lead_sigma = q.value("lead_sigma", 0.0);
-    if (!std::isfinite(t.lead_sigma) || t.lead_sigma < 0) throw InputError("a quality.lead_sigma that is not a number >= 0");
-    if (!fromName(t.answered_by)) throw InputError("a quality.answered_by that names no search: " + t.answered_by);
+    if (!plausibleQuality(t.answered_by, t.lead_sigma))
+      throw InputError("a quality no match gives: answered_by '" + t.answered_by + "', lead_sigma " +
+                       std::to_string(t.lead_sigma));
     return t;
   } catch (const nlohmann::json::exception& e) {
     throw InputError(std::string("not a stored transform: ") + e.what());

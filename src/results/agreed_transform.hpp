@@ -61,6 +61,11 @@ struct AgreedTransform {
   }
 };
 
+/// Whether a pair's quality is one a match gives: a lead that is a number
+/// >= 0 (the pose graph weighs by it), from a search tomomap has. Checked on
+/// every estimate received and every stored transform read.
+bool plausibleQuality(const std::string& answered_by, double lead_sigma);
+
 /// What a match says of a pair (reliable or why not, the transform, both
 /// maps' ups, quality); the pair's ids, versions and who computed it when
 /// are the caller's to set.

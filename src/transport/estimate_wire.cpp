@@ -43,8 +43,7 @@ Rejection fromWire(const wire::TransformEstimate& e, AgreedTransform& t) {
   if (e.target().to_string() >= e.source().to_string()) return {Reject::UnorderedPair};
   for (double v : {e.x(), e.y(), e.z(), e.yaw()})
     if (!std::isfinite(v)) return {Reject::NonFiniteTransform};
-  if (!std::isfinite(e.lead_sigma()) || e.lead_sigma() < 0 || !fromName(e.answered_by().to_string()))
-    return {Reject::BadQuality};
+  if (!plausibleQuality(e.answered_by().to_string(), e.lead_sigma())) return {Reject::BadQuality};
   Eigen::Matrix4d M;
   for (int row = 0; row < 4; ++row)
     for (int col = 0; col < 4; ++col) M(row, col) = e.matrix()[static_cast<size_t>(4 * row + col)];
