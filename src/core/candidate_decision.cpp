@@ -5,6 +5,7 @@
 #include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 #include <map>
+#include <set>
 
 #include "height_offsets.hpp"
 #include "text.hpp"
@@ -42,14 +43,14 @@ int votes(const Candidate& c) {
 /// difference per telling cell (the larger of the two), so that every slice
 /// weighs alike whatever its size.
 std::pair<double, int> occupancyLead(const SliceScores& a, const SliceScores& b) {
-  std::map<int, double> diff;
-  for (const auto& [k, v] : a) diff[k] = 0;
-  for (const auto& [k, v] : b) diff[k] = 0;
+  std::set<int> slices;
+  for (const auto& [k, v] : a) slices.insert(k);
+  for (const auto& [k, v] : b) slices.insert(k);
+  const std::pair<double, double> none{0.0, 0.0};
   std::vector<double> d;
-  for (const auto& [k, unused] : diff) {
-    const auto ia = a.find(k), ib = b.find(k);
-    const std::pair<double, double> va = ia == a.end() ? std::pair{0.0, 0.0} : ia->second;
-    const std::pair<double, double> vb = ib == b.end() ? std::pair{0.0, 0.0} : ib->second;
+  for (int k : slices) {
+    const auto& va = a.count(k) ? a.at(k) : none;
+    const auto& vb = b.count(k) ? b.at(k) : none;
     d.push_back((va.first - vb.first) / std::max({va.second, vb.second, 1.0}));
   }
   return {pairedLeadSigma(d), static_cast<int>(d.size())};
@@ -103,7 +104,13 @@ CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, co
     return onePlace(a.landed.transform, a.landed.offset, b.landed.transform, b.landed.offset, tolerance, source_centre);
   };
   std::vector<SliceScores> scores;
-  for (const Candidate& c : candidates) scores.push_back(occupancyBySlice(c));
+  std::vector<double> landed;  // each candidate's score, summed over its slices
+  std::vector<int> agreeing;   // the slice-pair estimates that agree with it
+  for (const Candidate& c : candidates) {
+    scores.push_back(occupancyBySlice(c));
+    landed.push_back(total(scores.back()));
+    agreeing.push_back(votes(c));
+  }
   // The best of those not at `at`'s place, by `better`; -1 if every one is there.
   const auto bestElsewhere = [&](size_t at, const auto& better) {
     int out = -1;
@@ -112,8 +119,8 @@ CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, co
         out = static_cast<int>(i);
     return out;
   };
-  const auto lands_more = [&](size_t a, size_t b) { return total(scores[a]) > total(scores[b]); };
-  const auto agreed_more = [&](size_t a, size_t b) { return votes(candidates[a]) > votes(candidates[b]); };
+  const auto lands_more = [&](size_t a, size_t b) { return landed[a] > landed[b]; };
+  const auto agreed_more = [&](size_t a, size_t b) { return agreeing[a] > agreeing[b]; };
 
   size_t best = 0;
   for (size_t i = 1; i < candidates.size(); ++i)
@@ -137,7 +144,7 @@ CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, co
   size_t voted = 0;
   for (size_t i = 1; i < candidates.size(); ++i)
     if (agreed_more(i, voted)) voted = i;
-  if (votes(candidates[voted]) == 0) return v;
+  if (agreeing[voted] == 0) return v;
   const int other = bestElsewhere(voted, agreed_more);
   if (other < 0) return v;
   const std::pair<double, int> by_votes = votesLead(candidates[voted], candidates[static_cast<size_t>(other)]);
