@@ -347,12 +347,12 @@ void Agent::finishCompute() {
     log_.warning("test fault wrong_pair: " + config_.faults.wrong_pair + " published moved 1.5 m and 30 deg");
   }
   const Pose4& T = t.T_target_source;
-  log_.info(
-      "computed " + pairText(t.pair()) + " in " + fixed(t.seconds, 2) + " s (" + std::to_string(computed.slice_pairs) +
-      " slice pairs, " + std::to_string(computed.slice_pairs_recalled) + " kept from its last match): " +
-      (t.reliable ? "x " + fixed(T.x, 3) + " y " + fixed(T.y, 3) + " z " + fixed(T.z, 3) + " yaw " + fixed(T.yaw, 4) +
-                        ", by " + t.answered_by + ", " + fixed(t.lead_sigma, 1) + " sigma clear"
-                  : "no reliable match: " + t.reason));
+  log_.info("computed " + pairText(t.pair()) + " in " + fixed(t.seconds, 2) + " s (" +
+            std::to_string(computed.slice_pairs) + " slice pairs, " + std::to_string(computed.slice_pairs_recalled) +
+            " kept from its last match): " +
+            (t.reliable ? "x " + fixed(T.x, 3) + " y " + fixed(T.y, 3) + " z " + fixed(T.z, 3) + " yaw " +
+                              fixed(T.yaw, 4) + ", by " + t.answered_by + ", " + fixed(t.lead_sigma, 1) + " sigma clear"
+                        : "no reliable match: " + t.reason));
   bus_->publish(transport::toWire(t));
   const PairKey pair = t.pair();
   board_.computed(std::move(t));

@@ -127,12 +127,13 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   if (!row.reliable) row.note = j.value("reason", "");
   if (j.contains("candidate_decision")) {
     const auto& answer = j["candidate_decision"]["answer"];
-    row.candidate_decision =
-        answer.is_null() ? "refused"
-                         : j["candidates"].at(answer.get<size_t>()).value("error", nlohmann::json::object()).value(
-                               "success", false)
-                               ? "right"
-                               : "wrong";
+    if (answer.is_null()) {
+      row.candidate_decision = "refused";
+    } else {
+      const auto& picked = j["candidates"].at(answer.get<size_t>());
+      row.candidate_decision =
+          picked.value("error", nlohmann::json::object()).value("success", false) ? "right" : "wrong";
+    }
   }
   const auto& s = j["slices"];
   row.features = s.value("target_features", 0.0) + s.value("source_features", 0.0);
@@ -255,7 +256,7 @@ struct EvalOptions {
   int sequence_pairs = 10;
   std::vector<std::string> methods;
   int threads = 0;
-  double timeout_s = 0;  ///< per run; 0 = none
+  double timeout_s = 0;     ///< per run; 0 = none
   bool candidates = false;  ///< tomomap's runs list their candidates; every run's JSON kept in OUT/results
 };
 
@@ -396,33 +397,31 @@ int runEval(const EvalOptions& o) {
       rows.push_back(r);
       // Written as they finish: an interrupted run keeps every finished row.
       rows_csv << csv(r) << std::endl;
-      rows_json << nlohmann::json{{"schema_version", kJsonSchemaVersion},
-                                  {"pair", r.pair},
-                                  {"noise", r.noise},
-                                  {"family", r.family},
-                                  {"method", r.method},
-                                  {"exit_code", r.exit_code},
-                                  {"reliable", r.reliable},
-                                  {"success", r.success},
-                                  {"translation_error_m", std::isnan(r.translation_error)
-                                                              ? nlohmann::json()
-                                                              : nlohmann::json(r.translation_error)},
-                                  {"translation_error_at_origin_m",
-                                   std::isnan(r.origin_error) ? nlohmann::json() : nlohmann::json(r.origin_error)},
-                                  {"yaw_error_rad",
-                                   std::isnan(r.yaw_error) ? nlohmann::json() : nlohmann::json(r.yaw_error)},
-                                  {"wall_s", r.seconds},
-                                  {"cpu_s", r.cpu_seconds},
-                                  {"peak_rss_mb", r.peak_rss_mb},
-                                  {"features", r.features},
-                                  {"feature_payload_bytes", r.payload_bytes},
-                                  {"raw_map_bytes", r.raw_bytes},
-                                  {"note", r.note},
-                                  {"candidate_decision", r.candidate_decision.empty()
-                                                             ? nlohmann::json()
-                                                             : nlohmann::json(r.candidate_decision)}}
-                       .dump()
-                << std::endl;
+      rows_json
+          << nlohmann::json{{"schema_version", kJsonSchemaVersion},
+                            {"pair", r.pair},
+                            {"noise", r.noise},
+                            {"family", r.family},
+                            {"method", r.method},
+                            {"exit_code", r.exit_code},
+                            {"reliable", r.reliable},
+                            {"success", r.success},
+                            {"translation_error_m",
+                             std::isnan(r.translation_error) ? nlohmann::json() : nlohmann::json(r.translation_error)},
+                            {"translation_error_at_origin_m",
+                             std::isnan(r.origin_error) ? nlohmann::json() : nlohmann::json(r.origin_error)},
+                            {"yaw_error_rad", std::isnan(r.yaw_error) ? nlohmann::json() : nlohmann::json(r.yaw_error)},
+                            {"wall_s", r.seconds},
+                            {"cpu_s", r.cpu_seconds},
+                            {"peak_rss_mb", r.peak_rss_mb},
+                            {"features", r.features},
+                            {"feature_payload_bytes", r.payload_bytes},
+                            {"raw_map_bytes", r.raw_bytes},
+                            {"note", r.note},
+                            {"candidate_decision",
+                             r.candidate_decision.empty() ? nlohmann::json() : nlohmann::json(r.candidate_decision)}}
+                 .dump()
+          << std::endl;
       std::cerr << "[" << rows.size() << "/" << total << "] " << std::left << std::setw(28) << p.name << " "
                 << std::setw(12) << m
                 << (r.success          ? "success"

@@ -102,7 +102,8 @@ FleetFrame matchAll(const std::vector<NamedMap>& maps, const std::vector<MapFeat
       const Pose4& T = a.T_target_source;
       std::cout << "pair             " << pairText(a.pair()) << ": "
                 << (a.reliable ? "x " + fixed(T.x, 3) + " y " + fixed(T.y, 3) + " z " + fixed(T.z, 3) + " m, yaw " +
-                                     fixed(degrees(T.yaw), 2) + " deg, " + a.answered_by + " " + fixed(a.lead_sigma, 1) + " sigma clear"
+                                     fixed(degrees(T.yaw), 2) + " deg, " + a.answered_by + " " +
+                                     fixed(a.lead_sigma, 1) + " sigma clear"
                                : "no reliable match: " + a.reason)
                 << "\n";
       agreed.push_back(std::move(a));
@@ -119,7 +120,8 @@ FleetFrame matchAll(const std::vector<NamedMap>& maps, const std::vector<MapFeat
 
 int runMerge(const MergeOptions& o) {
   const std::vector<NamedMap> maps = namedMaps(o.maps);
-  if (o.band.size() != 2 || !HeightBand{o.band[0], o.band[1]}.valid()) throw InputError("--band must be LOW,HIGH with LOW < HIGH");
+  if (o.band.size() != 2 || !HeightBand{o.band[0], o.band[1]}.valid())
+    throw InputError("--band must be LOW,HIGH with LOW < HIGH");
   std::error_code ec;  // checked before the work, so a typo costs no time
   fs::create_directories(o.out, ec);
   if (ec || !fs::is_directory(o.out)) throw InputError(o.out + ": cannot create the output folder: " + ec.message());

@@ -93,8 +93,7 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
     if (d.pooled_lead > 0)
       out << format("                 on occupancy pooled to twice the cell: %.2fx\n", d.pooled_lead);
     if (d.wide_lead > 0)
-      out << format("                 on a raster twice as fine, checking the features' answer: %.2fx\n",
-                    d.wide_lead);
+      out << format("                 on a raster twice as fine, checking the features' answer: %.2fx\n", d.wide_lead);
     if (d.second_look_apart)
       out << format("                 with the maps' roles swapped, the source's origin %.3f m from its pose\n",
                     *d.second_look_apart);
@@ -205,7 +204,8 @@ std::vector<std::optional<GroundTruthCheck>> candidateChecks(const MatchResult& 
                                                              const std::optional<GroundTruth>& truth, double grid) {
   std::vector<std::optional<GroundTruthCheck>> out(r.candidates.size());
   if (truth)
-    for (size_t i = 0; i < out.size(); ++i) out[i] = checkAgainstGroundTruth(r.candidates[i].T_own_frames, *truth, grid);
+    for (size_t i = 0; i < out.size(); ++i)
+      out[i] = checkAgainstGroundTruth(r.candidates[i].T_own_frames, *truth, grid);
   return out;
 }
 
@@ -261,17 +261,15 @@ void printCandidates(std::ostream& out, const MatchResult& r,
                      const std::vector<std::optional<GroundTruthCheck>>& checks) {
   std::vector<size_t> order(r.candidates.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return r.candidates[a].landed.score() > r.candidates[b].landed.score();
-  });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return r.candidates[a].landed.score() > r.candidates[b].landed.score(); });
   out << "candidates       " << r.candidates.size()
       << ", best refined score first: from (rank), score proposed -> refined, slices (where the target saw "
          "anything), contradicted cells\n";
   for (size_t i : order) {
     const Candidate& c = r.candidates[i];
-    out << format("  %-15s (%d) %9.0f -> %9.0f  %3d (%3d)  %6zu", fromName(c.from), c.rank,
-                  c.proposed_landed.score(), c.landed.score(), c.landed.support, c.landed.support_seen,
-                  c.landed.contradicted);
+    out << format("  %-15s (%d) %9.0f -> %9.0f  %3d (%3d)  %6zu", fromName(c.from), c.rank, c.proposed_landed.score(),
+                  c.landed.score(), c.landed.support, c.landed.support_seen, c.landed.contradicted);
     if (checks[i])
       out << format("  error %.3f m, %.4f rad: %s", checks[i]->error.translation, checks[i]->error.yaw,
                     checks[i]->success() ? "right" : "wrong");

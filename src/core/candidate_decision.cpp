@@ -86,8 +86,8 @@ double pairedLeadSigma(const std::vector<double>& differences) {
   for (double x : differences) ss += (x - mean) * (x - mean);
   const double se = std::sqrt(ss / static_cast<double>(n - 1) / static_cast<double>(n));
   if (se <= 0) return kMostSigma;
-  const double tail = boost::math::cdf(
-      boost::math::complement(boost::math::students_t(static_cast<double>(n - 1)), mean / se));
+  const double tail =
+      boost::math::cdf(boost::math::complement(boost::math::students_t(static_cast<double>(n - 1)), mean / se));
   if (!(tail > 1e-300)) return kMostSigma;
   return std::min(kMostSigma, boost::math::quantile(boost::math::complement(boost::math::normal(), tail)));
 }
@@ -133,10 +133,10 @@ CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, co
     v.lead_sigma = lead.first, v.slices = lead.second;
     return v;
   }
-  v.reason = rival < 0 ? "no candidate elsewhere to weigh the best against"
-                       : "the candidate that lands the most leads the best elsewhere by " + fixed(lead.first, 1) +
-                             " sigma over " + std::to_string(lead.second) + " slices (need " +
-                             fixed(kClearSigma, 0) + ")";
+  v.reason = rival < 0
+                 ? "no candidate elsewhere to weigh the best against"
+                 : "the candidate that lands the most leads the best elsewhere by " + fixed(lead.first, 1) +
+                       " sigma over " + std::to_string(lead.second) + " slices (need " + fixed(kClearSigma, 0) + ")";
 
   // The features' evidence, where the occupancy does not tell (a street's
   // poses along its facades land alike): answered only where the occupancy

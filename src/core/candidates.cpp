@@ -33,8 +33,9 @@ std::vector<Candidate> finished(std::vector<Candidate> out, const MapFeatures& t
     if (i < slices.size()) out[i].slices = std::move(slices[i]);
     if (i < pooled_slices.size()) out[i].pooled_slices = std::move(pooled_slices[i]);
     if (votes) out[i].feature_votes = votes(out[i].landed.transform, out[i].landed.offset);
-    out[i].T_own_frames = betweenOwnFrames(poseAt(out[i].landed.transform, out[i].landed.offset, target, source).matrix(),
-                                           target.slicedUp(), source.slicedUp());
+    out[i].T_own_frames =
+        betweenOwnFrames(poseAt(out[i].landed.transform, out[i].landed.offset, target, source).matrix(),
+                         target.slicedUp(), source.slicedUp());
   }
   return out;
 }
@@ -58,9 +59,9 @@ const char* fromName(Candidate::From from) {
 }
 
 std::optional<Candidate::From> fromName(const std::string& name) {
-  for (const Candidate::From from : {Candidate::From::features, Candidate::From::feature_rival,
-                                     Candidate::From::search_at_grid, Candidate::From::search_wide,
-                                     Candidate::From::search_pooled})
+  for (const Candidate::From from :
+       {Candidate::From::features, Candidate::From::feature_rival, Candidate::From::search_at_grid,
+        Candidate::From::search_wide, Candidate::From::search_pooled})
     if (name == fromName(from)) return from;
   return std::nullopt;
 }
@@ -92,9 +93,8 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
     return finished(std::move(out), target, source, dp, votes);
   std::vector<size_t> order(out.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return out[a].proposed_landed.score() > out[b].proposed_landed.score();
-  });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return out[a].proposed_landed.score() > out[b].proposed_landed.score(); });
   ConsensusParams same = consensusParams(params, target.grid);
   same.translation_tolerance = looksApart(params, target.grid);
   const Eigen::Vector2d centre = source.occupancy.grid.centre();

@@ -16,12 +16,12 @@ namespace tomomap {
 struct Candidate {
   enum class From { features, feature_rival, search_at_grid, search_wide, search_pooled };
   From from = From::features;
-  int rank = 0;             ///< its rank among its search's proposals (0: that search's best)
-  int feature_support = 0;  ///< agreeing slice pairs behind it (from features only)
-  Rigid2D proposed;         ///< as its search proposed it
-  int proposed_offset = 0;  ///< [slices]
-  DensePose proposed_landed;  ///< the proposal landed as it is
-  DensePose landed;           ///< refined (uphill, where it climbed) and landed
+  int rank = 0;                      ///< its rank among its search's proposals (0: that search's best)
+  int feature_support = 0;           ///< agreeing slice pairs behind it (from features only)
+  Rigid2D proposed;                  ///< as its search proposed it
+  int proposed_offset = 0;           ///< [slices]
+  DensePose proposed_landed;         ///< the proposal landed as it is
+  DensePose landed;                  ///< refined (uphill, where it climbed) and landed
   std::vector<SliceLanding> slices;  ///< `landed`, source slice by source slice
   /// `landed` on the occupancy pooled to twice the cell, slice by slice
   /// (pooled slices), for maps finer than DenseSearchParams::finest_empty_cell:

@@ -176,9 +176,9 @@ void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Propos
     if (!at_pooled && 2 * target.grid <= kBars.coarsest_pooled_cell + 1e-9)
       at_pooled = searchAt(target, source, pooled(ft), pooled(fs), 2, params);
   }
-  for (const auto& [o, from] : {std::pair{&at_grid, Candidate::From::search_at_grid},
-                                std::pair{&wide, Candidate::From::search_wide},
-                                std::pair{&at_pooled, Candidate::From::search_pooled}})
+  for (const auto& [o, from] :
+       {std::pair{&at_grid, Candidate::From::search_at_grid}, std::pair{&wide, Candidate::From::search_wide},
+        std::pair{&at_pooled, Candidate::From::search_pooled}})
     if (*o)
       for (size_t i = 0; i < (*o)->search.poses.size() && i < kProposalsPerSearch; ++i)
         proposals.push_back(
@@ -194,8 +194,8 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
   const auto t0 = std::chrono::steady_clock::now();
   const bool features = r.features.support > 0;  // the features proposed an answer (judged or not)
   const std::optional<Proposal> feature =
-      features ? std::optional<Proposal>(Proposal{Candidate::From::features, 0, r.features.support, planar(r.T_target_source),
-                                                  r.height_offset})
+      features ? std::optional<Proposal>(Proposal{Candidate::From::features, 0, r.features.support,
+                                                  planar(r.T_target_source), r.height_offset})
                : std::nullopt;
   std::optional<Opinion> at_grid, wide, at_pooled;
   // The searches that answer alone search the full slices alone (kFullSlice);

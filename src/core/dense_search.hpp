@@ -99,11 +99,11 @@ std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& sou
 
 /// How a pose lands one source slice's cells on the target (landPose's counts, slice by slice).
 struct SliceLanding {
-  int slice = 0;           ///< source slice index
-  uint32_t cells = 0;      ///< its occupied cells
-  uint32_t telling = 0;    ///< of them, telling (dense_search.cpp, cellsOf)
-  uint32_t seen = 0;       ///< landing where the target saw anything, at any height
-  uint32_t on = 0;         ///< landing on target cells (within inlier_radius_cells)
+  int slice = 0;         ///< source slice index
+  uint32_t cells = 0;    ///< its occupied cells
+  uint32_t telling = 0;  ///< of them, telling (dense_search.cpp, cellsOf)
+  uint32_t seen = 0;     ///< landing where the target saw anything, at any height
+  uint32_t on = 0;       ///< landing on target cells (within inlier_radius_cells)
   uint32_t telling_on = 0;
   uint32_t contradicted = 0;  ///< telling cells landing in space the target saw empty
 };

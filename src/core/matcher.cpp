@@ -106,8 +106,8 @@ void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const 
     std::vector<Vote> estimates;
     for (size_t k = 0; k < pairs.estimates.size(); ++k)
       if (pairs.matched[k] && pairs.estimates[k].ok)
-        estimates.push_back({source.slices[k % ns].index,
-                             target.slices[k / ns].index - source.slices[k % ns].index, pairs.estimates[k].T});
+        estimates.push_back({source.slices[k % ns].index, target.slices[k / ns].index - source.slices[k % ns].index,
+                             pairs.estimates[k].T});
     ev.feature_votes = [estimates = std::move(estimates), same = consensusParams(params, target.grid),
                         centre = source.centre(), n = source.occupancy.size()](const Rigid2D& T, int offset) {
       std::vector<int> by_slice(static_cast<size_t>(n), 0);
@@ -120,7 +120,7 @@ void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const 
     for (const OffsetScore& a : distinctAnswers(pairs, target, source, params))
       if (!sameAnswer(a, best, params, source.centre()))
         ev.feature_rivals.push_back({Candidate::From::feature_rival, ++rank, static_cast<int>(a.consensus.support()),
-                            a.consensus.mean, a.offset});
+                                     a.consensus.mean, a.offset});
   }
   for (size_t k : best.consensus.supporters)
     f.supporters.push_back({target.slices[k / ns].index, source.slices[k % ns].index, pairs.estimates[k].inliers});

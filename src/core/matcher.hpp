@@ -38,12 +38,12 @@ struct SupportingPair {
 /// What the tomographic match found, whatever the verdict made of it: each
 /// field means the same whichever search answered.
 struct FeatureFindings {
-  int support = 0;            ///< agreeing slice pairs behind the features' answer; 0: they had none
-  int runner_up_support = 0;  ///< of their best other answer (height_offsets.hpp OffsetChoice)
-  int runner_up_offset = 0;   ///< its height offset [slices]
-  int height_offset = 0;      ///< the features' answer's height offset [slices]
-  std::vector<SupportingPair> supporters;                   ///< the slice pairs behind `support`, most inliers first
-  size_t inliers = 0;                                       ///< feature correspondences consistent with their answer
+  int support = 0;                         ///< agreeing slice pairs behind the features' answer; 0: they had none
+  int runner_up_support = 0;               ///< of their best other answer (height_offsets.hpp OffsetChoice)
+  int runner_up_offset = 0;                ///< its height offset [slices]
+  int height_offset = 0;                   ///< the features' answer's height offset [slices]
+  std::vector<SupportingPair> supporters;  ///< the slice pairs behind `support`, most inliers first
+  size_t inliers = 0;                      ///< feature correspondences consistent with their answer
   Eigen::Vector3d inlier_spread = Eigen::Vector3d::Zero();  ///< std. dev. of those inliers in target x, y, z [m]
   size_t slice_pairs = 0;           ///< slice pairs matched (all, or those the offset votes point to)
   size_t slice_pairs_total = 0;     ///< n_target x n_source slices with features

@@ -51,8 +51,7 @@ std::optional<LandedChoice> chooseByLanding(const SlicePairTable& table, const M
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return landed[a].score() > landed[b].score(); });
   const DensePose& best = landed[order[0]];
-  if (!holdsOver(best, params.min_support) ||
-      significance(best.score(), landed[order[1]].score()) < kBars.significant)
+  if (!holdsOver(best, params.min_support) || significance(best.score(), landed[order[1]].score()) < kBars.significant)
     return std::nullopt;
   LandedChoice c{answers[order[0]]};
   for (size_t i = 1; i < order.size(); ++i)

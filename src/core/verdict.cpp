@@ -8,7 +8,6 @@
 namespace tomomap {
 namespace {
 
-
 /// Whether another feature answer has almost as much support as the winner.
 bool ambiguous(const FeatureEvidence& f, const MatchParams& params) {
   return f.runner_up_support > 0 && (f.support - f.runner_up_support < params.min_support ||
@@ -83,7 +82,8 @@ std::string shortfall(const DenseEvidence& d, double by, int slices, int need) {
   std::string out = "lead " + fixed(d.lead(), 2) + "x";
   if (d.lead() < by) out += ", need " + fixed(by, 2) + "x";
   const double sigma = significance(d.best.score(), d.next_score);
-  if (sigma < kBars.significant) out += "; " + fixed(sigma, 1) + " sigma beyond chance, need " + fixed(kBars.significant, 0);
+  if (sigma < kBars.significant)
+    out += "; " + fixed(sigma, 1) + " sigma beyond chance, need " + fixed(kBars.significant, 0);
   if (slices < need) out += "; over " + std::to_string(slices) + " slices, need " + std::to_string(need);
   return out;
 }
@@ -118,7 +118,8 @@ std::string howFarApart(const DenseEvidence& d) {
 std::string unconfirmed(const DenseEvidence& d) {
   const std::string what = "; a search on a raster twice as fine did not confirm it (";
   if (!d.at_features) return what + "its best pose lies " + howFarApart(d) + ")";
-  return what + shortfall(d, kBars.dense_opinion, d.best.support_seen, kBars.confirming_slices) + ")" + contradictionNote(d);
+  return what + shortfall(d, kBars.dense_opinion, d.best.support_seen, kBars.confirming_slices) + ")" +
+         contradictionNote(d);
 }
 
 Verdict by(Verdict::By b) { return {b, "", Verdict::Needs::nothing}; }
@@ -195,8 +196,7 @@ double answerLead(const Evidence& e, Verdict::By by) {
   for (const auto& [d, which] : searches)
     if (which == by && *d && (*d)->at_features) at_features = true;
   double lead = 0.0;
-  if (at_features && e.features.support > 0)
-    lead = significance(e.features.support, e.features.runner_up_support);
+  if (at_features && e.features.support > 0) lead = significance(e.features.support, e.features.runner_up_support);
   for (const auto& [d, which] : searches)
     if (*d && (*d)->found && (which == by || (at_features && (*d)->at_features)))
       lead = std::max(lead, significance((*d)->best.score(), (*d)->next_score));
@@ -248,8 +248,8 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
                fixed(kBars.significant, 0) + "): the occupancy does not pin it down";
       } else {
         why += "; the features' pose lands " + fixed(landed.score(), 0) + " telling cells, that pose " +
-               fixed(e.wide->best.score(), 0) + " (" + outscoring(landed, e.wide->best.score(), kBars.dense_lead, params) +
-               ")";
+               fixed(e.wide->best.score(), 0) + " (" +
+               outscoring(landed, e.wide->best.score(), kBars.dense_lead, params) + ")";
       }
     }
   }
@@ -282,8 +282,8 @@ Verdict decideMatch(const Evidence& e, const MatchParams& params) {
             "x lead for a pose " + howFarApart(grid) + ")";
   } else {
     if (clear) return preciseWhereStated(Verdict::By::at_grid, e, params);
-    why += "; nor did a dense search of the occupancy find a clear pose (" + shortfall(grid, kBars.dense_lead, params) + ")" +
-           contradictionNote(grid);
+    why += "; nor did a dense search of the occupancy find a clear pose (" + shortfall(grid, kBars.dense_lead, params) +
+           ")" + contradictionNote(grid);
   }
 
   // The pooled search answers with a clear pose of its own; it does not

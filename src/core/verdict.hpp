@@ -12,9 +12,6 @@
 
 namespace tomomap {
 
-
-
-
 /// Every bar the decision uses, each with its unit and how it was derived:
 /// the one place they are stated. (What the bars measure is defined where it
 /// is computed: a pose's score in dense_search.hpp, the smear of heights in

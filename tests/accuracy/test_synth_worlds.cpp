@@ -228,7 +228,8 @@ TEST(SmallRooms, WhereTheGridLeavesARoomRefusedPooledOccupancyAnswersIt) {
   for (const auto& [seed, noise] : {std::pair<uint64_t, const char*>{3, "low"}, {10, "high"}}) {
     const RoomMatch m = matchRoom(seed, noise, 0.05);
     expectAnsweredRightBy(m, 0.05, By::dense_search, "seed " + std::to_string(seed) + " " + noise);
-    EXPECT_EQ(m.result.answered_by, Candidate::From::search_pooled) << "seed " << seed << ": not the pooled search's answer";
+    EXPECT_EQ(m.result.answered_by, Candidate::From::search_pooled)
+        << "seed " << seed << ": not the pooled search's answer";
   }
 }
 

@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
   std::printf(
       "re-match after a cabinet, g %.2f, median of %d: from scratch %.3f s, recalling %.3f s (%zu of %zu "
       "slice pairs recalled, %s answer)\n",
-      p.grid, runs, quantile(fresh, 0.5), quantile(recalled, 0.5), b.features.slice_pairs_recalled, b.features.slice_pairs,
-      same ? "the same" : "A DIFFERENT");
+      p.grid, runs, quantile(fresh, 0.5), quantile(recalled, 0.5), b.features.slice_pairs_recalled,
+      b.features.slice_pairs, same ? "the same" : "A DIFFERENT");
   return same ? 0 : 1;
 }

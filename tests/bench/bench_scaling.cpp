@@ -55,7 +55,8 @@ int main(int argc, char** argv) {
       a.push_back(ra.timings.pair_matching);
       b.push_back(rb.timings.pair_matching);
     }
-    same = same && ra.reliable == rb.reliable && ra.height_offset == rb.height_offset && ra.features.support == rb.features.support;
+    same = same && ra.reliable == rb.reliable && ra.height_offset == rb.height_offset &&
+           ra.features.support == rb.features.support;
     const double slices = (t.slice_count + s.slice_count) / 2.0;
     fast.x.push_back(slices), fast.y.push_back(quantile(a, 0.5));
     slow.x.push_back(slices), slow.y.push_back(quantile(b, 0.5));

@@ -252,8 +252,8 @@ TEST(Cli, FpfhRansacBaselineRunsOnTheSamePair) {
   REQUIRE_DEMO_ROOM();
   TempDir dir;
   // At 0.1 m: at the demo's own 0.05 m the baseline took 43 s of CI's time, here 14 s (0.05 m off).
-  const auto r = test::runBinary(TOMOMAP_BASELINE_BIN,
-                                 demoMatchArgs().substr(6) + " --grid 0.1 -j 2 --json " + (dir / "b.json"));
+  const auto r =
+      test::runBinary(TOMOMAP_BASELINE_BIN, demoMatchArgs().substr(6) + " --grid 0.1 -j 2 --json " + (dir / "b.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("normals + FPFH"), std::string::npos);
   std::ifstream in(dir / "b.json");
@@ -293,9 +293,9 @@ TEST(Cli, CandidatesListEveryProposedPoseScoredWithItsError) {
   TempDir dir;
   const std::string w = dir / "room";
   ASSERT_EQ(runTomomap("synth --world room --seed 1 --noise low --out " + w).exit_code, 0);
-  const auto r = runTomomap("match " + w + "/map_0.pcd " + w + "/map_1.pcd --grid 0.1 --gt-target " + w +
-                            "/map_0-gtpose.txt --gt-source " + w + "/map_1-gtpose.txt --candidates --json " +
-                            (dir / "c.json"));
+  const auto r =
+      runTomomap("match " + w + "/map_0.pcd " + w + "/map_1.pcd --grid 0.1 --gt-target " + w +
+                 "/map_0-gtpose.txt --gt-source " + w + "/map_1-gtpose.txt --candidates --json " + (dir / "c.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("candidates       "), std::string::npos) << r.output;
   const auto j = nlohmann::json::parse(std::ifstream(dir / "c.json"));

@@ -34,7 +34,7 @@ TEST(CandidateDecision, ALeadCountsByItsSlicesSpreadAndNumber) {
   EXPECT_GT(pairedLeadSigma({2, 2, 2, 2}), 30.0) << "the same lead on every slice";
   // The same t (3.4-3.5) over 3 slices and over 50: the few count for less.
   const double few = pairedLeadSigma({1.0, 2.0, 3.0});  // t = 2 / (1 / sqrt 3) = 3.46, 2 degrees of freedom
-  EXPECT_NEAR(few, 1.79, 0.02);                          // tail 3.7 %
+  EXPECT_NEAR(few, 1.79, 0.02);                         // tail 3.7 %
   std::vector<double> spread;
   for (int k = 0; k < 50; ++k) spread.push_back(k % 2 ? 2.0 + 4.08 : 2.0 - 4.08);
   EXPECT_NEAR(pairedLeadSigma(spread), 3.23, 0.02);  // t = 3.43, 49 degrees of freedom
