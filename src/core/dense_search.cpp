@@ -89,17 +89,19 @@ struct Enclosure {
   }
 };
 
-/// A stack of coarse binary images in the frequency domain (OpenCV's packed
-/// real spectra) at a common padded size; an empty Mat for an empty image.
-std::vector<cv::Mat> spectra(const std::vector<cv::Mat>& images, cv::Size padded) {
-  std::vector<cv::Mat> out(images.size());
-  for (size_t k = 0; k < images.size(); ++k) {
-    if (cv::countNonZero(images[k]) == 0) continue;
-    cv::Mat big = cv::Mat::zeros(padded, CV_32F);
-    images[k].copyTo(big(cv::Rect(0, 0, images[k].cols, images[k].rows)));
-    cv::dft(big, out[k]);
+/// The packed real spectrum (OpenCV's CCS) of a coarse binary `image`
+/// zero-padded to `padded`, into `out`; `out` empty for an empty image. `big`
+/// is scratch of the padded size: kept from call to call, it spares an
+/// allocation (and its page faults) per image and yaw step.
+void spectrumOf(const cv::Mat& image, cv::Size padded, cv::Mat& big, cv::Mat& out) {
+  if (cv::countNonZero(image) == 0) {
+    out.release();
+    return;
   }
-  return out;
+  big.create(padded, CV_32F);
+  big.setTo(0);
+  image.copyTo(big(cv::Rect(0, 0, image.cols, image.rows)));
+  cv::dft(big, out, 0, image.rows);  // the rows below the image are zero: their transforms are skipped
 }
 
 /// The best shift at one (yaw, coarse height offset).
@@ -326,43 +328,52 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   for (int k = 0; k < target.size(); ++k)
     for (uint32_t idx : target.cells[static_cast<size_t>(k)])
       timg[static_cast<size_t>(k / c)].at<float>(static_cast<int>(idx / tw) / c, static_cast<int>(idx % tw) / c) = 1.f;
-  const std::vector<cv::Mat> tspec = spectra(timg, padded);
+  std::vector<cv::Mat> tspec(timg.size());
+  {
+    cv::Mat big;
+    for (size_t k = 0; k < timg.size(); ++k) spectrumOf(timg[k], padded, big, tspec[k]);
+  }
 
   const int steps = std::max(1, static_cast<int>(std::lround(2.0 * kPi / params.yaw_step)));
   std::vector<std::vector<Peak>> peaks(static_cast<size_t>(steps));
-#pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
-  for (int step = 0; step < steps; ++step) {
-    const double yaw = 2.0 * kPi * step / steps, cs = std::cos(yaw), sn = std::sin(yaw);
-    std::vector<cv::Mat> simg(static_cast<size_t>(zs));
-    for (auto& m : simg) m = cv::Mat::zeros(xs, xs, CV_32F);
-    for (const Cell& cell : source_cells) {
-      const Eigen::Vector2d d = cell.p - centre;
-      const int u = static_cast<int>((cs * d.x() - sn * d.y() + radius) / C);
-      const int v = static_cast<int>((sn * d.x() + cs * d.y() + radius) / C);
-      simg[static_cast<size_t>(cell.slice / c)].at<float>(v, u) = 1.f;
-    }
-    const std::vector<cv::Mat> sspec = spectra(simg, padded);
-    cv::Mat acc, product, corr;
-    for (int dz = -(zs - 1); dz <= zt - 1; ++dz) {
-      bool any = false;
-      for (int z = std::max(0, -dz); z < zs && z + dz < zt; ++z) {
-        const cv::Mat& a = tspec[static_cast<size_t>(z + dz)];
-        const cv::Mat& b = sspec[static_cast<size_t>(z)];
-        if (a.empty() || b.empty()) continue;
-        cv::mulSpectrums(a, b, product, 0, true);
-        if (any)
-          acc += product;
-        else
-          product.copyTo(acc);
-        any = true;
+#pragma omp parallel num_threads(std::max(1, params.threads))
+  {
+    // Each thread's images and spectra, reused from yaw step to yaw step.
+    std::vector<cv::Mat> simg(static_cast<size_t>(zs)), sspec(static_cast<size_t>(zs));
+    for (auto& m : simg) m.create(xs, xs, CV_32F);
+    cv::Mat big, acc, product, corr;
+#pragma omp for schedule(dynamic)
+    for (int step = 0; step < steps; ++step) {
+      const double yaw = 2.0 * kPi * step / steps, cs = std::cos(yaw), sn = std::sin(yaw);
+      for (auto& m : simg) m.setTo(0);
+      for (const Cell& cell : source_cells) {
+        const Eigen::Vector2d d = cell.p - centre;
+        const int u = static_cast<int>((cs * d.x() - sn * d.y() + radius) / C);
+        const int v = static_cast<int>((sn * d.x() + cs * d.y() + radius) / C);
+        simg[static_cast<size_t>(cell.slice / c)].at<float>(v, u) = 1.f;
       }
-      if (!any) continue;
-      cv::dft(acc, corr, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
-      double best = 0;
-      cv::Point at;
-      cv::minMaxLoc(corr, nullptr, &best, nullptr, &at);
-      const int dx = at.x < xt ? at.x : at.x - padded.width, dy = at.y < yt ? at.y : at.y - padded.height;
-      peaks[static_cast<size_t>(step)].push_back({best, step, dz, dx, dy});
+      for (size_t k = 0; k < simg.size(); ++k) spectrumOf(simg[k], padded, big, sspec[k]);
+      for (int dz = -(zs - 1); dz <= zt - 1; ++dz) {
+        bool any = false;
+        for (int z = std::max(0, -dz); z < zs && z + dz < zt; ++z) {
+          const cv::Mat& a = tspec[static_cast<size_t>(z + dz)];
+          const cv::Mat& b = sspec[static_cast<size_t>(z)];
+          if (a.empty() || b.empty()) continue;
+          cv::mulSpectrums(a, b, product, 0, true);
+          if (any)
+            acc += product;
+          else
+            product.copyTo(acc);
+          any = true;
+        }
+        if (!any) continue;
+        cv::dft(acc, corr, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+        double best = 0;
+        cv::Point at;
+        cv::minMaxLoc(corr, nullptr, &best, nullptr, &at);
+        const int dx = at.x < xt ? at.x : at.x - padded.width, dy = at.y < yt ? at.y : at.y - padded.height;
+        peaks[static_cast<size_t>(step)].push_back({best, step, dz, dx, dy});
+      }
     }
   }
 
