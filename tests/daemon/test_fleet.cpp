@@ -195,8 +195,14 @@ TEST(Fleet, AComputerKilledMidMatchIsTakenOver) {
   // Full-length maps: a match takes seconds, time to kill its computer.
   SynthFleet world(dir, ids, 1.0);
   Fleet fleet(dir);
+  // alpha<-bravo is charlie's turn (computeOrder); alpha and bravo hold both
+  // maps, and one claim timeout after they do, alpha takes a turn charlie has
+  // not claimed. A busy charlie can be later than the tests' 8 s: under the
+  // sanitizers, beside the regression matrix, it described its own map in
+  // 11 s and alpha computed the pair. The daemon's default, 30 s, keeps the
+  // turn charlie's.
+  fleet.claim_timeout_s = 30;
   for (const auto& a : world.agents) fleet.start(a, world.agents);
-  // alpha<-bravo is charlie's turn (computeOrder); alpha and bravo hold both maps.
   ASSERT_TRUE(
       Fleet::waitFor([&] { return fleet.log("charlie").find("computing alpha<-bravo") != std::string::npos; }, 300s))
       << allLogs(fleet, ids);
@@ -205,13 +211,16 @@ TEST(Fleet, AComputerKilledMidMatchIsTakenOver) {
     GTEST_SKIP() << "charlie finished before it was killed: nothing to take over";
 
   const std::vector<std::string> survivors{"alpha", "bravo"};
+  // Told by liveliness that charlie is gone, a survivor takes the pair at
+  // once; otherwise after charlie's claim lapses (a claim timeout) and its
+  // own turn comes (one more).
   ASSERT_TRUE(Fleet::waitFor(
       [&] {
         for (const auto& id : survivors)
           if (!fleet.transforms(id).count("alpha<-bravo")) return false;
         return true;
       },
-      120s))
+      300s))
       << allLogs(fleet, ids);
   const auto t = fleet.transforms("alpha").at("alpha<-bravo");
   EXPECT_NE(t["computed_by"], "charlie");
