@@ -6,9 +6,7 @@
 #     out: `ctest -L large` runs it; so is the hundred thousand fuzzed samples'
 #     test, which the sanitizer build runs, where a memory error is caught);
 #  2. a build with AddressSanitizer and UndefinedBehaviorSanitizer: the unit
-#     and daemon tests again, where any sanitizer report fails the run. The
-#     Release build's regression matrix runs beside them: its matches keep
-#     the cores busy while the sanitizers' chain of fleets waits on its peers.
+#     and daemon tests again, where any sanitizer report fails the run.
 # Each phase says how long it took (docs/results.md, "CI time", has the figures).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,9 +19,8 @@ took() { echo "== $1 took $((SECONDS - phase)) s ($((SECONDS - start)) s so far)
 
 scripts/build.sh
 took "release build"
-release_dir=$(realpath "${BUILD_DIR:-build}")
-(cd "$release_dir" && ctest --output-on-failure -j"$jobs" --timeout 1200 -LE large \
-  -E "AHundredThousandFuzzedSamples|RegressionMatrix")
+(cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j"$jobs" --timeout 1200 -LE large \
+  -E AHundredThousandFuzzedSamples)
 took "release tests"
 
 echo "== sanitizer build (ASan + UBSan): unit and daemon tests"
@@ -54,22 +51,6 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # checks that flag the pair run here in FleetFrame's unit tests. The fleet
 # tests run one at a time (tests/CMakeLists.txt): under the sanitizers their
 # chain, not the unit tests beside it, sets this phase's time.
-# The matrix (Release) beside them: it took 645 s of the release tests' 831,
-# most of their time on its own while the rest had finished; here it fills
-# the cores the fleets leave idle. Its output follows the sanitizer tests'.
-matrix_log=$(mktemp)
-(cd "$release_dir" && ctest --output-on-failure --timeout 1200 -R RegressionMatrix >"$matrix_log" 2>&1) &
-matrix=$!
-asan_status=0
 (cd build-asan && ctest --output-on-failure -j"$jobs" --timeout 1200 -L "unit|daemon" \
-  -E "SixAgents|TenAgents|UnderEachDiscoverySetting|FourAgentsFlagAWrongPair") || asan_status=$?
-matrix_status=0
-wait "$matrix" || matrix_status=$?
-echo "== the regression matrix (Release), beside the sanitizer tests:"
-cat "$matrix_log"
-rm -f "$matrix_log"
-took "sanitizer tests and the regression matrix"
-if [ "$asan_status" -ne 0 ] || [ "$matrix_status" -ne 0 ]; then
-  echo "FAILED: sanitizer tests exit $asan_status, regression matrix exit $matrix_status" >&2
-  exit 1
-fi
+  -E "SixAgents|TenAgents|UnderEachDiscoverySetting|FourAgentsFlagAWrongPair")
+took "sanitizer tests"
