@@ -45,8 +45,9 @@ class Fleet {
 
   uint16_t port(size_t index) const { return static_cast<uint16_t>(base_port_ + 4 * index); }
 
-  /// Written into every config: a claim without a result or renewal is void after this [s].
-  double claim_timeout_s = 8;
+  /// Written into every config: a claim without a result or renewal is void
+  /// after this [s]; unset, the daemon's own default.
+  std::optional<double> claim_timeout_s = 8;
 
   /// Writes the config of `spec`; `everyone` lists the fleet (for ports).
   std::string writeConfig(const AgentSpec& spec, const std::vector<AgentSpec>& everyone) {
@@ -55,8 +56,9 @@ class Fleet {
     if (!spec.map.empty()) c << "map = \"" << spec.map << "\"\n";  // none: a map from a ROS 2 topic
     c << "grid = " << spec.grid << "\ndiscovery_port = " << port(indexOf(spec.id, everyone))
       << "\nbandwidth_kbps = " << spec.bandwidth_kbps << "\noutput_dir = \"" << (dir_ / ("out-" + spec.id))
-      << "\"\nrequest_interval_s = 1\nclaim_timeout_s = " << claim_timeout_s << "\n"
-      << spec.extra;
+      << "\"\nrequest_interval_s = 1\n";
+    if (claim_timeout_s) c << "claim_timeout_s = " << *claim_timeout_s << "\n";
+    c << spec.extra;
     for (const auto& other : everyone) {
       if (other.id == spec.id) continue;
       if (!spec.peers.empty() && std::find(spec.peers.begin(), spec.peers.end(), other.id) == spec.peers.end())

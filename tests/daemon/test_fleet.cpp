@@ -199,9 +199,9 @@ TEST(Fleet, AComputerKilledMidMatchIsTakenOver) {
   // maps, and one claim timeout after they do, alpha takes a turn charlie has
   // not claimed. A busy charlie can be later than the tests' 8 s: under the
   // sanitizers, beside the regression matrix, it described its own map in
-  // 11 s and alpha computed the pair. The daemon's default, 30 s, keeps the
+  // 11 s and alpha computed the pair. The daemon's default (30 s) keeps the
   // turn charlie's.
-  fleet.claim_timeout_s = 30;
+  fleet.claim_timeout_s.reset();
   for (const auto& a : world.agents) fleet.start(a, world.agents);
   ASSERT_TRUE(
       Fleet::waitFor([&] { return fleet.log("charlie").find("computing alpha<-bravo") != std::string::npos; }, 300s))
