@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "dense_refine.hpp"
+#include "spectrum_correlation.hpp"
 
 namespace tomomap {
 
@@ -341,7 +342,9 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
     // Each thread's images and spectra, reused from yaw step to yaw step.
     std::vector<cv::Mat> simg(static_cast<size_t>(zs)), sspec(static_cast<size_t>(zs));
     for (auto& m : simg) m.create(xs, xs, CV_32F);
-    cv::Mat big, acc, product, corr;
+    cv::Mat big, corr;
+    std::vector<cv::Mat> sums;  // per height offset
+    std::vector<char> summed;
 #pragma omp for schedule(dynamic)
     for (int step = 0; step < steps; ++step) {
       const double yaw = 2.0 * kPi * step / steps, cs = std::cos(yaw), sn = std::sin(yaw);
@@ -353,25 +356,15 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
         simg[static_cast<size_t>(cell.slice / c)].at<float>(v, u) = 1.f;
       }
       for (size_t k = 0; k < simg.size(); ++k) spectrumOf(simg[k], padded, big, sspec[k]);
+      correlateStacks(tspec, sspec, sums, summed);
       for (int dz = -(zs - 1); dz <= zt - 1; ++dz) {
-        bool any = false;
-        for (int z = std::max(0, -dz); z < zs && z + dz < zt; ++z) {
-          const cv::Mat& a = tspec[static_cast<size_t>(z + dz)];
-          const cv::Mat& b = sspec[static_cast<size_t>(z)];
-          if (a.empty() || b.empty()) continue;
-          cv::mulSpectrums(a, b, product, 0, true);
-          if (any)
-            acc += product;
-          else
-            product.copyTo(acc);
-          any = true;
-        }
-        if (!any) continue;
-        cv::dft(acc, corr, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+        const size_t at = static_cast<size_t>(dz + zs - 1);
+        if (!summed[at]) continue;
+        cv::dft(sums[at], corr, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
         double best = 0;
-        cv::Point at;
-        cv::minMaxLoc(corr, nullptr, &best, nullptr, &at);
-        const int dx = at.x < xt ? at.x : at.x - padded.width, dy = at.y < yt ? at.y : at.y - padded.height;
+        cv::Point top;
+        cv::minMaxLoc(corr, nullptr, &best, nullptr, &top);
+        const int dx = top.x < xt ? top.x : top.x - padded.width, dy = top.y < yt ? top.y : top.y - padded.height;
         peaks[static_cast<size_t>(step)].push_back({best, step, dz, dx, dy});
       }
     }
