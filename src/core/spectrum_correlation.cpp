@@ -50,17 +50,37 @@ void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& 
     out[at].setTo(0);
   }
   const int cols = size.width;
-  const int last_pair = cols % 2 == 0 ? cols - 2 : cols - 1;  // the last column of (re, im) pairs
-  for (int r = 0; r < size.height; ++r)
+  // The (re, im) pairs of columns 1, 2 to the last pair's, a row at a time,
+  // laid out as a plane of re and one of im, so that the sums vectorise.
+  const size_t n = static_cast<size_t>(cols % 2 == 0 ? cols - 2 : cols - 1) / 2;
+  std::vector<float> a_re(a.size() * n), a_im(a_re.size()), b_re(b.size() * n), b_im(b_re.size());
+  std::vector<float> c_re(offsets * n), c_im(c_re.size());
+  const auto split = [n](const cv::Mat& m, int r, float* re, float* im) {
+    const float* row = m.ptr<float>(r);
+    for (size_t i = 0; i < n; ++i) re[i] = row[2 * i + 1], im[i] = row[2 * i + 2];
+  };
+  for (int r = 0; r < size.height; ++r) {
+    for (size_t k = 0; k < a.size(); ++k)
+      if (!a[k].empty()) split(a[k], r, &a_re[k * n], &a_im[k * n]);
+    for (size_t k = 0; k < b.size(); ++k)
+      if (!b[k].empty()) split(b[k], r, &b_re[k * n], &b_im[k * n]);
     for (size_t at = 0; at < offsets; ++at) {
       if (!any[at]) continue;
-      float* c = out[at].ptr<float>(r);
+      float* __restrict re = &c_re[at * n];
+      float* __restrict im = &c_im[at * n];
+      std::fill(re, re + n, 0.f);
+      std::fill(im, im + n, 0.f);
       for (const auto& [ia, ib] : pairs[at]) {
-        const float* x = a[static_cast<size_t>(ia)].ptr<float>(r);
-        const float* y = b[static_cast<size_t>(ib)].ptr<float>(r);
-        for (int j = 1; j < last_pair; j += 2) addConjugateProduct(x[j], x[j + 1], y[j], y[j + 1], c[j], c[j + 1]);
+        const float* __restrict xr = &a_re[static_cast<size_t>(ia) * n];
+        const float* __restrict xi = &a_im[static_cast<size_t>(ia) * n];
+        const float* __restrict yr = &b_re[static_cast<size_t>(ib) * n];
+        const float* __restrict yi = &b_im[static_cast<size_t>(ib) * n];
+        for (size_t i = 0; i < n; ++i) addConjugateProduct(xr[i], xi[i], yr[i], yi[i], re[i], im[i]);
       }
+      float* row = out[at].ptr<float>(r);
+      for (size_t i = 0; i < n; ++i) row[2 * i + 1] = re[i], row[2 * i + 2] = im[i];
     }
+  }
   for (size_t at = 0; at < offsets; ++at) {
     if (!any[at]) continue;
     for (const auto& [ia, ib] : pairs[at]) {
