@@ -29,7 +29,7 @@ void addColumn(const cv::Mat& a, const cv::Mat& b, cv::Mat& c, int col) {
 }  // namespace
 
 void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& b, std::vector<cv::Mat>& out,
-                     std::vector<char>& any) {
+                     std::vector<char>& any, const std::vector<char>& wanted) {
   const int na = static_cast<int>(a.size()), nb = static_cast<int>(b.size());
   const size_t offsets = static_cast<size_t>(std::max(0, na + nb - 1));
   out.resize(offsets);
@@ -41,6 +41,7 @@ void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& 
   std::vector<std::vector<std::pair<int, int>>> pairs(offsets);
   for (int dz = -(nb - 1); dz <= na - 1; ++dz) {
     const size_t at = static_cast<size_t>(dz + nb - 1);
+    if (!wanted.empty() && !wanted[at]) continue;
     for (int z = std::max(0, -dz); z < nb && z + dz < na; ++z)
       if (!a[static_cast<size_t>(z + dz)].empty() && !b[static_cast<size_t>(z)].empty())
         pairs[at].emplace_back(z + dz, z);

@@ -11,7 +11,8 @@ namespace tomomap {
 /// summed over z gives (up to float rounding), on OpenCV's packed (CCS) real
 /// spectra of one size. Into out[dz + b.size() - 1]; `any` says which offsets had at
 /// least one pair of non-empty spectra (an empty cv::Mat is an empty image's
-/// spectrum). `out` keeps its buffers from call to call.
+/// spectrum), of those `wanted` (all where it is empty). `out` keeps its
+/// buffers from call to call.
 ///
 /// Why not mulSpectrums: its product is a whole matrix written out and read
 /// back to be added, once per pair of slices. This walks the spectra a row at
@@ -19,6 +20,6 @@ namespace tomomap {
 /// it adds to stay in the cache: on the largest rooms the sums and products
 /// were a quarter of a match.
 void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& b, std::vector<cv::Mat>& out,
-                     std::vector<char>& any);
+                     std::vector<char>& any, const std::vector<char>& wanted = {});
 
 }  // namespace tomomap
