@@ -62,20 +62,20 @@ void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& 
   };
   for (int r = 0; r < size.height; ++r) {
     for (size_t k = 0; k < a.size(); ++k)
-      if (!a[k].empty()) split(a[k], r, &a_re[k * n], &a_im[k * n]);
+      if (!a[k].empty()) split(a[k], r, a_re.data() + k * n, a_im.data() + k * n);
     for (size_t k = 0; k < b.size(); ++k)
-      if (!b[k].empty()) split(b[k], r, &b_re[k * n], &b_im[k * n]);
+      if (!b[k].empty()) split(b[k], r, b_re.data() + k * n, b_im.data() + k * n);
     for (size_t at = 0; at < offsets; ++at) {
       if (!any[at]) continue;
-      float* __restrict re = &c_re[at * n];
-      float* __restrict im = &c_im[at * n];
+      float* __restrict re = c_re.data() + at * n;
+      float* __restrict im = c_im.data() + at * n;
       std::fill(re, re + n, 0.f);
       std::fill(im, im + n, 0.f);
       for (const auto& [ia, ib] : pairs[at]) {
-        const float* __restrict xr = &a_re[static_cast<size_t>(ia) * n];
-        const float* __restrict xi = &a_im[static_cast<size_t>(ia) * n];
-        const float* __restrict yr = &b_re[static_cast<size_t>(ib) * n];
-        const float* __restrict yi = &b_im[static_cast<size_t>(ib) * n];
+        const float* __restrict xr = a_re.data() + static_cast<size_t>(ia) * n;
+        const float* __restrict xi = a_im.data() + static_cast<size_t>(ia) * n;
+        const float* __restrict yr = b_re.data() + static_cast<size_t>(ib) * n;
+        const float* __restrict yi = b_im.data() + static_cast<size_t>(ib) * n;
         for (size_t i = 0; i < n; ++i) addConjugateProduct(xr[i], xi[i], yr[i], yi[i], re[i], im[i]);
       }
       float* row = out[at].ptr<float>(r);
