@@ -347,8 +347,8 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   std::vector<std::vector<std::optional<Peak>>> peaks(static_cast<size_t>(steps),
                                                       std::vector<std::optional<Peak>>(offsets));
   std::vector<std::vector<char>> done(static_cast<size_t>(steps), std::vector<char>(offsets, 0));
-  // Correlates the offsets of `todo`'s steps not done yet that could score `floor` or more.
-  const auto correlate = [&](const std::vector<int>& todo, double floor) {
+  // Correlates the offsets of `todo`'s steps not done yet that could score `bar` or more.
+  const auto correlate = [&](const std::vector<int>& todo, double bar) {
 #pragma omp parallel num_threads(std::max(1, params.threads))
     {
       // Each thread's images and spectra, reused from yaw step to yaw step.
@@ -378,7 +378,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
           for (int z = std::max(0, -dz); z < zs && z + dz < zt; ++z)
             most += std::min(target_count[static_cast<size_t>(z + dz)], source_count[static_cast<size_t>(z)]);
           // Half a cell for the transforms' rounding.
-          wanted[at] = !finished[at] && most + 0.5 >= floor;
+          wanted[at] = !finished[at] && most + 0.5 >= bar;
           any = any || wanted[at];
         }
         if (!any) continue;
@@ -429,13 +429,11 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
     return static_cast<int>(coarse.size()) >= params.candidates ? last : -std::numeric_limits<double>::infinity();
   };
   // Every kSampled-th yaw step is correlated first, at every height offset;
-  // the last of the distinct poses their peaks give scores a floor. The other
-  // steps then correlate only the offsets whose bound reaches the floor. If
+  // the last of the distinct poses their peaks give scores a bar. The other
+  // steps then correlate only the offsets whose bound reaches the bar. If
   // the distinct poses of all the peaks still end at or above it, every peak
   // that could be among them was correlated, and they are the poses a search
   // of every offset chooses; otherwise the offsets left out are correlated too.
-  // (On the largest rooms at g 0.05 most offsets at the stacks' ends fall
-  // below the floor: they overlap in a few slices.)
   constexpr int kSampled = 4;
   std::vector<int> sampled, others, every;
   for (int step = 0; step < steps; ++step) {
@@ -445,9 +443,9 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   const double lowest = -std::numeric_limits<double>::infinity();
   correlate(sampled, lowest);
   std::vector<DensePose> coarse;
-  const double floor = distinct(coarse);
-  correlate(others, floor);
-  if (distinct(coarse) < floor) {
+  const double bar = distinct(coarse);
+  correlate(others, bar);
+  if (distinct(coarse) < bar) {
     correlate(every, lowest);
     distinct(coarse);
   }

@@ -1,6 +1,7 @@
 #include "spectrum_correlation.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace tomomap {
 namespace {
@@ -37,6 +38,7 @@ void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& 
   cv::Size size;
   for (const cv::Mat& m : a)
     if (!m.empty()) size = m.size();
+  if (size.empty()) return;  // every a is an empty image's: no offset has a pair
   // The pairs (z + dz, z) of non-empty spectra, offset by offset.
   std::vector<std::vector<std::pair<int, int>>> pairs(offsets);
   for (int dz = -(nb - 1); dz <= na - 1; ++dz) {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <opencv2/core.hpp>
 
 #include "core/spectrum_correlation.hpp"
@@ -65,4 +66,15 @@ TEST(SpectrumCorrelation, AnOffsetWithoutAPairOfNonEmptySlicesIsNotSummed) {
   correlateStacks(a, b, sums, any);
   ASSERT_EQ(any.size(), 5u);
   EXPECT_EQ(std::vector<char>(any.begin(), any.end()), (std::vector<char>{0, 1, 1, 0, 0}));
+}
+
+TEST(SpectrumCorrelation, StacksOfEmptySlicesSumNothing) {
+  // A peer's map may come as slices without a cell: no offset is summed.
+  const std::vector<cv::Mat> empty(3), b = spectra(2, cv::Size(6, 6), {}, 5);
+  std::vector<cv::Mat> sums;
+  std::vector<char> any;
+  correlateStacks(empty, b, sums, any);
+  EXPECT_EQ(std::vector<char>(any.begin(), any.end()), std::vector<char>(4, 0));
+  correlateStacks(b, empty, sums, any);
+  EXPECT_EQ(std::vector<char>(any.begin(), any.end()), std::vector<char>(4, 0));
 }
