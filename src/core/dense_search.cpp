@@ -346,9 +346,8 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   // Each (yaw step, height offset)'s peak, once correlated.
   std::vector<std::vector<std::optional<Peak>>> peaks(static_cast<size_t>(steps),
                                                       std::vector<std::optional<Peak>>(offsets));
-  std::vector<std::vector<char>> done(static_cast<size_t>(steps), std::vector<char>(offsets, 0));
-  // Correlates the offsets of `todo`'s steps not done yet that could score `bar` or more.
-  const auto correlate = [&](const std::vector<int>& todo, double bar) {
+  // Correlates the offsets of `todo`'s steps whose bound lies in [from, below).
+  const auto correlate = [&](const std::vector<int>& todo, double from, double below) {
 #pragma omp parallel num_threads(std::max(1, params.threads))
     {
       // Each thread's images and spectra, reused from yaw step to yaw step.
@@ -370,15 +369,14 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
         }
         std::vector<int> source_count(simg.size());
         for (size_t k = 0; k < simg.size(); ++k) source_count[k] = cv::countNonZero(simg[k]);
-        std::vector<char>& finished = done[static_cast<size_t>(step)];
         bool any = false;
         for (int dz = -(zs - 1); dz <= zt - 1; ++dz) {
           const size_t at = static_cast<size_t>(dz + zs - 1);
           int most = 0;
           for (int z = std::max(0, -dz); z < zs && z + dz < zt; ++z)
             most += std::min(target_count[static_cast<size_t>(z + dz)], source_count[static_cast<size_t>(z)]);
-          // Half a cell for the transforms' rounding.
-          wanted[at] = !finished[at] && most + 0.5 >= bar;
+          const double bound = most + 0.5;  // half a cell for the transforms' rounding
+          wanted[at] = bound >= from && bound < below;
           any = any || wanted[at];
         }
         if (!any) continue;
@@ -386,8 +384,6 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
         correlateStacks(tspec, sspec, sums, summed, wanted);
         for (int dz = -(zs - 1); dz <= zt - 1; ++dz) {
           const size_t at = static_cast<size_t>(dz + zs - 1);
-          if (!wanted[at]) continue;
-          finished[at] = 1;
           if (!summed[at]) continue;
           cv::dft(sums[at], corr, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
           double best = 0;
@@ -435,18 +431,15 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   // that could be among them was correlated, and they are the poses a search
   // of every offset chooses; otherwise the offsets left out are correlated too.
   constexpr int kSampled = 4;
-  std::vector<int> sampled, others, every;
-  for (int step = 0; step < steps; ++step) {
-    (step % kSampled == 0 ? sampled : others).push_back(step);
-    every.push_back(step);
-  }
-  const double lowest = -std::numeric_limits<double>::infinity();
-  correlate(sampled, lowest);
+  std::vector<int> sampled, others;
+  for (int step = 0; step < steps; ++step) (step % kSampled == 0 ? sampled : others).push_back(step);
+  constexpr double kAny = std::numeric_limits<double>::infinity();
+  correlate(sampled, -kAny, kAny);
   std::vector<DensePose> coarse;
   const double bar = distinct(coarse);
-  correlate(others, bar);
+  correlate(others, bar, kAny);
   if (distinct(coarse) < bar) {
-    correlate(every, lowest);
+    correlate(others, -kAny, bar);
     distinct(coarse);
   }
 
