@@ -10,9 +10,9 @@
 # Each phase says how long it took (docs/results.md, "CI time", has the figures).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-# One ctest slot more than cores: one slot mostly waits on a daemon fleet
-# (tests/CMakeLists.txt), the others keep the cores busy.
-jobs=$(($(nproc) + 1))
+# Two ctest slots more than cores: two slots mostly wait on a daemon fleet each
+# (two chains, tests/CMakeLists.txt), the others keep the cores busy.
+jobs=$(($(nproc) + 2))
 start=$SECONDS
 phase=$SECONDS
 took() { echo "== $1 took $((SECONDS - phase)) s ($((SECONDS - start)) s so far)"; phase=$SECONDS; }
@@ -39,8 +39,8 @@ took "sanitizer build"
 # dynamic TLS blocks as roots of their own.
 export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:new_delete_type_mismatch=0:intercept_tls_get_addr=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-# One run for both labels: a daemon test (one fleet at a time, mostly waiting
-# on its peers) goes beside the CPU-bound unit tests. The daemon tests take
+# One run for both labels: the daemon tests (two chains of one fleet at a time,
+# mostly waiting on their peers) go beside the CPU-bound unit tests. The daemon tests take
 # Fast DDS's own security leaks as suppressed (tests/CMakeLists.txt).
 # Six and ten daemons under ASan on two cores would take most of CI's time:
 # the three-agent fleet test runs the same code paths here, the Release run
@@ -49,8 +49,8 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # fleet-map tests run here once each. So does the four-agent wrong-pair test:
 # its daemons run the three-agent test's paths, and the fleet frame's cycle
 # checks that flag the pair run here in FleetFrame's unit tests. The fleet
-# tests run one at a time (tests/CMakeLists.txt): under the sanitizers their
-# chain, not the unit tests beside it, sets this phase's time.
+# tests run in two chains (tests/CMakeLists.txt): under the sanitizers the
+# longer chain, not the unit tests beside it, sets this phase's time.
 (cd build-asan && ctest --output-on-failure -j"$jobs" --timeout 1200 -L "unit|daemon" \
   -E "SixAgents|TenAgents|UnderEachDiscoverySetting|FourAgentsFlagAWrongPair")
 took "sanitizer tests"

@@ -8,11 +8,13 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <string>
 #include <thread>
 
 #include "support.hpp"
@@ -34,8 +36,13 @@ struct AgentSpec {
 class Fleet {
  public:
   explicit Fleet(TempDir& dir) : dir_(dir) {
-    // Ports apart per test process: ctest runs tests side by side.
-    base_port_ = static_cast<uint16_t>(23000 + (::getpid() % 400) * 40);
+    // Ports apart per test process: ctest runs tests side by side. ctest
+    // gives each chain of fleets a base of its own (tests/CMakeLists.txt);
+    // elsewhere (a test run by hand beside another) the process id picks one.
+    if (const char* base = std::getenv("TOMOMAP_TEST_PORT_BASE"))
+      base_port_ = static_cast<uint16_t>(std::stoi(base));
+    else
+      base_port_ = static_cast<uint16_t>(23000 + (::getpid() % 400) * 40);
   }
   ~Fleet() {
     std::vector<std::string> ids;
