@@ -339,14 +339,12 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
 
   const int steps = std::max(1, static_cast<int>(std::lround(2.0 * kPi / params.yaw_step)));
   const size_t offsets = static_cast<size_t>(zs + zt - 1);
-  // A coarse cell coincides with one other at most: a height offset scores
-  // at most the sum, over its slice pairs, of the fewer cells of the two.
-  std::vector<int> target_count(timg.size());
-  for (size_t k = 0; k < timg.size(); ++k) target_count[k] = cv::countNonZero(timg[k]);
+  std::vector<int> target_occupied(timg.size());  // coarse cells per slice: what bounds each offset's peak
+  for (size_t k = 0; k < timg.size(); ++k) target_occupied[k] = cv::countNonZero(timg[k]);
   // Each (yaw step, height offset)'s peak, once correlated.
   std::vector<std::vector<std::optional<Peak>>> peaks(static_cast<size_t>(steps),
                                                       std::vector<std::optional<Peak>>(offsets));
-  // Correlates the offsets of `todo`'s steps whose bound lies in [from, below).
+  // Correlates the offsets of `todo`'s steps that may peak in [from, below).
   const auto correlate = [&](const std::vector<int>& todo, double from, double below) {
 #pragma omp parallel num_threads(std::max(1, params.threads))
     {
@@ -355,7 +353,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
       for (auto& m : simg) m.create(xs, xs, CV_32F);
       cv::Mat big, corr;
       std::vector<cv::Mat> sums;  // per height offset
-      std::vector<char> summed, wanted(offsets);
+      std::vector<char> summed;
 #pragma omp for schedule(dynamic)
       for (size_t n = 0; n < todo.size(); ++n) {
         const int step = todo[n];
@@ -367,19 +365,10 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
           const int v = static_cast<int>((sn * d.x() + cs * d.y() + radius) / C);
           simg[static_cast<size_t>(cell.slice / c)].at<float>(v, u) = 1.f;
         }
-        std::vector<int> source_count(simg.size());
-        for (size_t k = 0; k < simg.size(); ++k) source_count[k] = cv::countNonZero(simg[k]);
-        bool any = false;
-        for (int dz = -(zs - 1); dz <= zt - 1; ++dz) {
-          const size_t at = static_cast<size_t>(dz + zs - 1);
-          int most = 0;
-          for (int z = std::max(0, -dz); z < zs && z + dz < zt; ++z)
-            most += std::min(target_count[static_cast<size_t>(z + dz)], source_count[static_cast<size_t>(z)]);
-          const double bound = most + 0.5;  // half a cell for the transforms' rounding
-          wanted[at] = bound >= from && bound < below;
-          any = any || wanted[at];
-        }
-        if (!any) continue;
+        std::vector<int> source_occupied(simg.size());
+        for (size_t k = 0; k < simg.size(); ++k) source_occupied[k] = cv::countNonZero(simg[k]);
+        const std::vector<char> wanted = offsetsPeakingWithin(target_occupied, source_occupied, from, below);
+        if (std::none_of(wanted.begin(), wanted.end(), [](char w) { return w; })) continue;
         for (size_t k = 0; k < simg.size(); ++k) spectrumOf(simg[k], padded, big, sspec[k]);
         correlateStacks(tspec, sspec, sums, summed, wanted);
         for (int dz = -(zs - 1); dz <= zt - 1; ++dz) {

@@ -27,7 +27,29 @@ void addColumn(const cv::Mat& a, const cv::Mat& b, cv::Mat& c, int col) {
   if (r < rows) c.at<float>(r, col) += a.at<float>(r, col) * b.at<float>(r, col);
 }
 
+/// Calls f(za, zb) for the slice pairs of offset dz: a[z + dz] with b[z],
+/// for each z that both stacks (of na and nb slices) hold.
+template <class F>
+void forEachPair(int na, int nb, int dz, F&& f) {
+  for (int z = std::max(0, -dz); z < nb && z + dz < na; ++z) f(z + dz, z);
+}
+
 }  // namespace
+
+std::vector<char> offsetsPeakingWithin(const std::vector<int>& a_cells, const std::vector<int>& b_cells, double from,
+                                       double below) {
+  const int na = static_cast<int>(a_cells.size()), nb = static_cast<int>(b_cells.size());
+  std::vector<char> out(static_cast<size_t>(std::max(0, na + nb - 1)));
+  for (int dz = -(nb - 1); dz <= na - 1; ++dz) {
+    int most = 0;
+    forEachPair(na, nb, dz, [&](int za, int zb) {
+      most += std::min(a_cells[static_cast<size_t>(za)], b_cells[static_cast<size_t>(zb)]);
+    });
+    const double bound = most + 0.5;  // half a cell for the transforms' rounding
+    out[static_cast<size_t>(dz + nb - 1)] = bound >= from && bound < below;
+  }
+  return out;
+}
 
 void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& b, std::vector<cv::Mat>& out,
                      std::vector<char>& any, const std::vector<char>& wanted) {
@@ -44,9 +66,9 @@ void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& 
   for (int dz = -(nb - 1); dz <= na - 1; ++dz) {
     const size_t at = static_cast<size_t>(dz + nb - 1);
     if (!wanted.empty() && !wanted[at]) continue;
-    for (int z = std::max(0, -dz); z < nb && z + dz < na; ++z)
-      if (!a[static_cast<size_t>(z + dz)].empty() && !b[static_cast<size_t>(z)].empty())
-        pairs[at].emplace_back(z + dz, z);
+    forEachPair(na, nb, dz, [&](int za, int zb) {
+      if (!a[static_cast<size_t>(za)].empty() && !b[static_cast<size_t>(zb)].empty()) pairs[at].emplace_back(za, zb);
+    });
     if (pairs[at].empty()) continue;
     any[at] = 1;
     out[at].create(size, CV_32F);

@@ -22,4 +22,12 @@ namespace tomomap {
 void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& b, std::vector<cv::Mat>& out,
                      std::vector<char>& any, const std::vector<char>& wanted = {});
 
+/// Which offsets (indexed as correlateStacks indexes them) may peak at a
+/// score in [from, below), for binary images holding a_cells[z] and
+/// b_cells[z] set cells: a cell coincides with one other at most, so an
+/// offset peaks at most at the sum, over its slice pairs, of the fewer cells.
+/// What correlateStacks' `wanted` takes.
+std::vector<char> offsetsPeakingWithin(const std::vector<int>& a_cells, const std::vector<int>& b_cells, double from,
+                                       double below);
+
 }  // namespace tomomap

@@ -78,3 +78,55 @@ TEST(SpectrumCorrelation, StacksOfEmptySlicesSumNothing) {
   correlateStacks(b, empty, sums, any);
   EXPECT_EQ(std::vector<char>(any.begin(), any.end()), std::vector<char>(4, 0));
 }
+
+TEST(SpectrumCorrelation, AnOffsetsBoundIsTheSumOfItsSlicePairsFewerCells) {
+  // a holds 3, 0 and 5 cells, b 2 and 4: offset -1 pairs a0 with b1 (at most
+  // 3), 0 pairs a0 with b0 and a1 with b1 (2), 1 pairs a1 with b0 and a2 with
+  // b1 (4), and 2 pairs a2 with b0 (2); half a cell more each, for rounding.
+  const std::vector<int> a{3, 0, 5}, b{2, 4};
+  EXPECT_EQ(offsetsPeakingWithin(a, b, 3, 4.5), (std::vector<char>{1, 0, 0, 0}));
+  EXPECT_EQ(offsetsPeakingWithin(a, b, 0, 3), (std::vector<char>{0, 1, 0, 1}));
+  EXPECT_EQ(offsetsPeakingWithin(a, b, 4.5, 100), (std::vector<char>{0, 0, 1, 0}));
+}
+
+TEST(SpectrumCorrelation, NoOffsetPeaksAboveItsBoundAndOneStackOnItselfReachesIt) {
+  // Random binary slices, zero-padded as the search pads them: every
+  // offset's correlation peaks within its bound, and a stack laid on itself
+  // at offset 0 scores every cell it has.
+  const cv::Size size(12, 10), padded(24, 20);
+  cv::RNG rng(6);
+  const auto stack = [&](int n) {
+    std::vector<cv::Mat> spectra(static_cast<size_t>(n));
+    std::vector<int> cells(spectra.size());
+    for (size_t k = 0; k < spectra.size(); ++k) {
+      cv::Mat noise(size, CV_32F), big = cv::Mat::zeros(padded, CV_32F);
+      rng.fill(noise, cv::RNG::UNIFORM, 0, 2);
+      cv::Mat(noise > 1.4).convertTo(big(cv::Rect(cv::Point(0, 0), size)), CV_32F, 1.0 / 255);
+      cells[k] = cv::countNonZero(big);
+      cv::dft(big, spectra[k]);
+    }
+    return std::pair{spectra, cells};
+  };
+  const auto [a, a_cells] = stack(4);
+  const auto [b, b_cells] = stack(3);
+  const auto peaks = [](const std::vector<cv::Mat>& x, const std::vector<cv::Mat>& y) {
+    std::vector<cv::Mat> sums;
+    std::vector<char> any;
+    correlateStacks(x, y, sums, any);
+    std::vector<double> out(sums.size(), 0);
+    for (size_t at = 0; at < sums.size(); ++at) {
+      cv::Mat corr;
+      cv::dft(sums[at], corr, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+      cv::minMaxLoc(corr, nullptr, &out[at]);
+    }
+    return out;
+  };
+  const std::vector<double> ab = peaks(a, b);
+  for (size_t at = 0; at < ab.size(); ++at)
+    EXPECT_TRUE(offsetsPeakingWithin(a_cells, b_cells, ab[at], 1e9)[at]) << "offset index " << at << " peak " << ab[at];
+  const std::vector<double> aa = peaks(a, a);
+  int all = 0;
+  for (int n : a_cells) all += n;
+  EXPECT_NEAR(aa[3], all, 1e-3);  // offset 0 of two 4-slice stacks
+  EXPECT_FALSE(offsetsPeakingWithin(a_cells, a_cells, all + 1, 1e9)[3]);
+}
