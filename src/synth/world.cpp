@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/types.hpp"
+
 namespace tomomap::synth {
 namespace {
 
@@ -68,26 +70,88 @@ double Ground::height(double x, double y) const { return a1 * std::sin(x / l1) +
 
 double Ground::maxSlope() const { return std::abs(a1 / l1) + std::abs(a2 / l2) + std::abs(slope); }
 
+namespace {
+
+/// Sectors of azimuth around a sensor: a degree each, so that a room's wall
+/// seen from inside it spans few of them, and a ray tests a few solids.
+constexpr int kSectors = 360;
+constexpr double kSectorWidth = 2 * kPi / kSectors;  // [rad]
+/// A solid's outline within this of the sensor (seen from above) surrounds
+/// it for every ray [m]; its span is widened by kPad [rad] each way. Both far
+/// beyond rounding: the sectors only ever hold more solids than can be hit.
+constexpr double kTouching = 1e-6, kPad = 1e-7;
+
+/// The sector an azimuth [rad] (any turn) falls in, as an unwrapped count.
+long sectorCount(double azimuth) { return std::lround(std::floor(azimuth / kSectorWidth)); }
+size_t wrapSector(long k) { return static_cast<size_t>(((k % kSectors) + kSectors) % kSectors); }
+
+/// Files `solid` under every sector that azimuths [from, to] (to >= from) touch.
+template <class T>
+void fileUnder(std::vector<NearbySolids::Sector>& sectors, std::vector<const T*> NearbySolids::Sector::*list,
+               const T* solid, double from, double to) {
+  const long first = sectorCount(from - kPad), last = std::min(sectorCount(to + kPad), first + kSectors - 1);
+  for (long k = first; k <= last; ++k) (sectors[wrapSector(k)].*list).push_back(solid);
+}
+
+/// Files a solid whose outline seen from above is the disc at `centre` of
+/// `radius`, seen from `o`: every sector if the disc holds o.
+template <class T>
+void fileDisc(std::vector<NearbySolids::Sector>& sectors, std::vector<const T*> NearbySolids::Sector::*list,
+              const T* solid, const Eigen::Vector2d& centre, double radius, const Eigen::Vector2d& o) {
+  const Eigen::Vector2d to = centre - o;
+  const double distance = to.norm();
+  if (distance <= radius + kTouching) return fileUnder(sectors, list, solid, 0.0, 2 * kPi);
+  const double middle = std::atan2(to.y(), to.x()), half = std::asin(radius / distance);
+  fileUnder(sectors, list, solid, middle - half, middle + half);
+}
+
+}  // namespace
+
+const NearbySolids::Sector& NearbySolids::along(const Eigen::Vector3d& dir) const {
+  return sectors[wrapSector(sectorCount(std::atan2(dir.y(), dir.x())))];
+}
+
 NearbySolids solidsNear(const World& world, const Eigen::Vector3d& origin, double range) {
   NearbySolids n;
+  n.sectors.resize(kSectors);
   const Eigen::Vector2d o = origin.head<2>();
   for (const auto& b : world.boxes) {
-    const Eigen::Vector2d closest = o.cwiseMax(b.lo.head<2>()).cwiseMin(b.hi.head<2>());
-    if ((closest - o).norm() <= range) n.boxes.push_back(&b);
+    const Eigen::Vector2d lo = b.lo.head<2>(), hi = b.hi.head<2>();
+    const Eigen::Vector2d closest = o.cwiseMax(lo).cwiseMin(hi);
+    if ((closest - o).norm() > range) continue;
+    if ((closest - o).cwiseAbs().maxCoeff() <= kTouching) {
+      fileUnder(n.sectors, &NearbySolids::Sector::boxes, &b, 0.0, 2 * kPi);
+      continue;
+    }
+    // Seen from outside, a rectangle spans less than a half turn, and its
+    // centre's direction lies within that span: its corners' bearings from
+    // that direction bound it.
+    const Eigen::Vector2d mid = 0.5 * (lo + hi) - o;
+    const double middle = std::atan2(mid.y(), mid.x());
+    double from = 0, to = 0;
+    for (const Eigen::Vector2d& corner : {lo, hi, Eigen::Vector2d(lo.x(), hi.y()), Eigen::Vector2d(hi.x(), lo.y())}) {
+      const Eigen::Vector2d c = corner - o;
+      const double off = std::remainder(std::atan2(c.y(), c.x()) - middle, 2 * kPi);
+      from = std::min(from, off), to = std::max(to, off);
+    }
+    fileUnder(n.sectors, &NearbySolids::Sector::boxes, &b, middle + from, middle + to);
   }
   for (const auto& c : world.cylinders)
-    if ((c.centre - o).norm() - c.radius <= range) n.cylinders.push_back(&c);
+    if ((c.centre - o).norm() - c.radius <= range)
+      fileDisc(n.sectors, &NearbySolids::Sector::cylinders, &c, c.centre, c.radius, o);
   for (const auto& s : world.spheres)
-    if ((s.centre.head<2>() - o).norm() - s.radius <= range) n.spheres.push_back(&s);
+    if ((s.centre.head<2>() - o).norm() - s.radius <= range)
+      fileDisc(n.sectors, &NearbySolids::Sector::spheres, &s, Eigen::Vector2d(s.centre.head<2>()), s.radius, o);
   return n;
 }
 
 double castRay(const World& world, const NearbySolids& near, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                double max_range) {
   double best = max_range;
-  for (const Box* b : near.boxes) best = std::min(best, hitBox(*b, origin, dir));
-  for (const Cylinder* c : near.cylinders) best = std::min(best, hitCylinder(*c, origin, dir));
-  for (const Sphere* s : near.spheres) best = std::min(best, hitSphere(*s, origin, dir));
+  const NearbySolids::Sector& sector = near.along(dir);
+  for (const Box* b : sector.boxes) best = std::min(best, hitBox(*b, origin, dir));
+  for (const Cylinder* c : sector.cylinders) best = std::min(best, hitCylinder(*c, origin, dir));
+  for (const Sphere* s : sector.spheres) best = std::min(best, hitSphere(*s, origin, dir));
   if (world.ground.enabled) best = std::min(best, hitGround(world.ground, origin, dir, best));
   return best < max_range ? best : kInf;
 }

@@ -34,11 +34,19 @@ struct World {
   Ground ground;
 };
 
-/// The solids near one sensor position, so a scan tests only what it can reach.
+/// The solids near one sensor position, so a scan tests only what it can
+/// reach, each filed under every sector of azimuth it spans from there: a ray
+/// can only hit a solid whose outline seen from above it points into, so it
+/// tests only its own sector's (the same first hit as testing them all).
 struct NearbySolids {
-  std::vector<const Box*> boxes;
-  std::vector<const Cylinder*> cylinders;
-  std::vector<const Sphere*> spheres;
+  struct Sector {
+    std::vector<const Box*> boxes;
+    std::vector<const Cylinder*> cylinders;
+    std::vector<const Sphere*> spheres;
+  };
+  std::vector<Sector> sectors;  ///< kSectors, counter-clockwise from +x
+  /// The sector a ray along `dir` points into.
+  const Sector& along(const Eigen::Vector3d& dir) const;
 };
 
 NearbySolids solidsNear(const World& world, const Eigen::Vector3d& origin, double range);

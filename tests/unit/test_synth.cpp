@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <random>
 #include <set>
 #include <tuple>
 
@@ -19,6 +21,45 @@ TEST(World, RayHitsTheNearestSolid) {
   EXPECT_NEAR(castRay(w, near, o, {0, 1, 0}, 20), 7.5, 1e-9);
   EXPECT_TRUE(std::isinf(castRay(w, near, o, {-1, 0, 0}, 20)));
   EXPECT_TRUE(std::isinf(castRay(w, near, o, {1, 0, 0}, 2.0)));  // beyond max range
+}
+
+TEST(World, ARayTestingOnlyItsSectorsSolidsFindsTheFirstHitOfAll) {
+  // Random boxes, trunks and crowns around sensors inside, beside and on the
+  // edge of them: the first hit is the nearest of every solid's own, to the bit.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> at(-6, 6), size(0.05, 3), unit(-1, 1);
+  World w;
+  for (int k = 0; k < 40; ++k) {
+    const Eigen::Vector3d lo(at(rng), at(rng), at(rng) / 3);
+    w.boxes.push_back({lo, lo + Eigen::Vector3d(size(rng), size(rng), size(rng))});
+  }
+  for (int k = 0; k < 10; ++k) w.cylinders.push_back({{at(rng), at(rng)}, size(rng) / 4, -2, 2});
+  for (int k = 0; k < 10; ++k) w.spheres.push_back({{at(rng), at(rng), at(rng) / 3}, size(rng) / 2});
+  const auto firstOfAll = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+    double first = std::numeric_limits<double>::infinity();
+    const auto alone = [&](World one) { first = std::min(first, castRay(one, solidsNear(one, o, 30), o, d, 30)); };
+    for (const Box& b : w.boxes) alone(World{{b}, {}, {}, {}});
+    for (const Cylinder& c : w.cylinders) alone(World{{}, {c}, {}, {}});
+    for (const Sphere& s : w.spheres) alone(World{{}, {}, {s}, {}});
+    return first;
+  };
+  std::vector<Eigen::Vector3d> origins{
+      w.boxes[0].lo, 0.5 * (w.boxes[1].lo + w.boxes[1].hi),
+      Eigen::Vector3d(w.cylinders[0].centre.x() + w.cylinders[0].radius, w.cylinders[0].centre.y(), 0)};
+  for (int k = 0; k < 20; ++k) origins.emplace_back(at(rng), at(rng), at(rng) / 3);
+  int hits = 0;
+  for (const Eigen::Vector3d& o : origins) {
+    const NearbySolids near = solidsNear(w, o, 30);
+    for (int k = 0; k < 400; ++k) {
+      Eigen::Vector3d d(unit(rng), unit(rng), unit(rng) / 2);
+      if (k % 50 == 0) d = Eigen::Vector3d(0, 0, k % 100 == 0 ? 1 : -1);  // straight up or down
+      d.normalize();
+      const double t = castRay(w, near, o, d, 30);
+      ASSERT_EQ(t, firstOfAll(o, d)) << "from " << o.transpose() << " along " << d.transpose();
+      hits += std::isfinite(t);
+    }
+  }
+  EXPECT_GT(hits, 4000);  // most rays hit something: the comparison is not of misses
 }
 
 TEST(World, RayFindsUnevenGround) {
