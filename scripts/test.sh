@@ -24,7 +24,7 @@ took "release build"
 took "release tests"
 
 echo "== sanitizer build (ASan + UBSan): unit and daemon tests"
-BUILD_DIR=build-asan TARGETS="unit_tests daemon_tests tomomapd tomomap" \
+BUILD_DIR=build-asan TARGETS=unit_and_daemon_tests \
   scripts/build.sh -DTOMOMAP_SANITIZE=ON
 took "sanitizer build"
 # new_delete_type_mismatch=0: Debian's Fast DDS 2.9.1 deletes its statistics
