@@ -25,7 +25,8 @@ TEST(World, RayHitsTheNearestSolid) {
 
 TEST(World, ARayTestingOnlyItsSectorsSolidsFindsTheFirstHitOfAll) {
   // Random boxes, trunks and crowns around sensors inside, beside and on the
-  // edge of them: the first hit is the nearest of every solid's own, to the bit.
+  // edge of them: the first hit is the one that testing every solid finds,
+  // to the bit.
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> at(-6, 6), size(0.05, 3), unit(-1, 1);
   World w;
@@ -35,13 +36,15 @@ TEST(World, ARayTestingOnlyItsSectorsSolidsFindsTheFirstHitOfAll) {
   }
   for (int k = 0; k < 10; ++k) w.cylinders.push_back({{at(rng), at(rng)}, size(rng) / 4, -2, 2});
   for (int k = 0; k < 10; ++k) w.spheres.push_back({{at(rng), at(rng), at(rng) / 3}, size(rng) / 2});
-  const auto firstOfAll = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
-    double first = std::numeric_limits<double>::infinity();
-    const auto alone = [&](World one) { first = std::min(first, castRay(one, solidsNear(one, o, 30), o, d, 30)); };
-    for (const Box& b : w.boxes) alone(World{{b}, {}, {}, {}});
-    for (const Cylinder& c : w.cylinders) alone(World{{}, {c}, {}, {}});
-    for (const Sphere& s : w.spheres) alone(World{{}, {}, {s}, {}});
-    return first;
+  // Every solid under every sector: what a ray tested before the sectors.
+  const auto everySolidEverywhere = [&](const Eigen::Vector3d& o) {
+    NearbySolids near = solidsNear(w, o, 30);
+    NearbySolids::Sector all;
+    for (const Box& b : w.boxes) all.boxes.push_back(&b);
+    for (const Cylinder& c : w.cylinders) all.cylinders.push_back(&c);
+    for (const Sphere& s : w.spheres) all.spheres.push_back(&s);
+    near.sectors.assign(near.sectors.size(), all);
+    return near;
   };
   std::vector<Eigen::Vector3d> origins{
       w.boxes[0].lo, 0.5 * (w.boxes[1].lo + w.boxes[1].hi),
@@ -49,13 +52,34 @@ TEST(World, ARayTestingOnlyItsSectorsSolidsFindsTheFirstHitOfAll) {
   for (int k = 0; k < 20; ++k) origins.emplace_back(at(rng), at(rng), at(rng) / 3);
   int hits = 0;
   for (const Eigen::Vector3d& o : origins) {
-    const NearbySolids near = solidsNear(w, o, 30);
+    const NearbySolids near = solidsNear(w, o, 30), all = everySolidEverywhere(o);
+    std::vector<Eigen::Vector3d> rays;
     for (int k = 0; k < 400; ++k) {
       Eigen::Vector3d d(unit(rng), unit(rng), unit(rng) / 2);
       if (k % 50 == 0) d = Eigen::Vector3d(0, 0, k % 100 == 0 ? 1 : -1);  // straight up or down
+      rays.push_back(d);
+    }
+    // Rays just inside a solid's outline, near where its span of azimuths
+    // ends: by a box's corners and a trunk's sides, half way up.
+    for (const Box& b : w.boxes) {
+      const Eigen::Vector2d mid = 0.5 * (b.lo + b.hi).head<2>();
+      for (const Eigen::Vector2d& corner : {Eigen::Vector2d(b.lo.head<2>()), Eigen::Vector2d(b.hi.head<2>()),
+                                            Eigen::Vector2d(b.lo.x(), b.hi.y()), Eigen::Vector2d(b.hi.x(), b.lo.y())}) {
+        const Eigen::Vector2d inside = corner + 0.02 * (mid - corner) - o.head<2>();
+        rays.emplace_back(inside.x(), inside.y(), 0.5 * (b.lo.z() + b.hi.z()) - o.z());
+      }
+    }
+    for (const Cylinder& c : w.cylinders) {
+      const Eigen::Vector2d to = c.centre - o.head<2>();
+      if (to.norm() <= c.radius) continue;
+      const double side = 0.98 * std::asin(c.radius / to.norm()), along = std::atan2(to.y(), to.x());
+      for (const double a : {along - side, along + side})
+        rays.emplace_back(std::cos(a), std::sin(a), -o.z() / to.norm());
+    }
+    for (Eigen::Vector3d d : rays) {
       d.normalize();
       const double t = castRay(w, near, o, d, 30);
-      ASSERT_EQ(t, firstOfAll(o, d)) << "from " << o.transpose() << " along " << d.transpose();
+      ASSERT_EQ(t, castRay(w, all, o, d, 30)) << "from " << o.transpose() << " along " << d.transpose();
       hits += std::isfinite(t);
     }
   }
