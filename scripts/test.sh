@@ -49,8 +49,9 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # fleet-map tests run here once each. So does the four-agent wrong-pair test:
 # its daemons run the three-agent test's paths, and the fleet frame's cycle
 # checks that flag the pair run here in FleetFrame's unit tests. The fleet
-# tests run in two chains (tests/CMakeLists.txt): under the sanitizers the
-# longer chain, not the unit tests beside it, sets this phase's time.
+# tests run in two chains (tests/CMakeLists.txt); with one chain its length
+# set this phase's time, with two the phase is bound by the CPU (docs/results.md,
+# "CI time").
 (cd build-asan && ctest --output-on-failure -j"$jobs" --timeout 1200 -L "unit|daemon" \
   -E "SixAgents|TenAgents|UnderEachDiscoverySetting|FourAgentsFlagAWrongPair")
 took "sanitizer tests"
