@@ -147,21 +147,29 @@ Tally countInliers(const std::vector<cv::Mat>& dilated, const std::vector<Cell>&
     per_slice->assign(static_cast<size_t>(source_slices), SliceLanding{});
     for (int k = 0; k < source_slices; ++k) (*per_slice)[static_cast<size_t>(k)].slice = k;
   }
+  // Each source slice's target image at `offset` (null where there is none),
+  // looked up once per call rather than once per cell.
+  std::vector<const uint8_t*> image(static_cast<size_t>(source_slices), nullptr);
+  for (int k = 0; k < source_slices; ++k)
+    if (const int i = k + offset;
+        i >= 0 && i < static_cast<int>(dilated.size()) && !dilated[static_cast<size_t>(i)].empty())
+      image[static_cast<size_t>(k)] = dilated[static_cast<size_t>(i)].ptr<uint8_t>();
+  const uint8_t* seen_pixels = seen ? seen->ptr<uint8_t>() : nullptr;
   for (size_t n = 0; n < cells.size(); ++n) {
     const Cell& c = cells[n];
     SliceLanding* s = per_slice ? &(*per_slice)[static_cast<size_t>(c.slice)] : nullptr;
     if (s) ++s->cells, s->telling += c.telling;
-    const int i = c.slice + offset;
-    if (i < 0 || i >= static_cast<int>(dilated.size()) || dilated[static_cast<size_t>(i)].empty()) continue;
+    const uint8_t* target = image[static_cast<size_t>(c.slice)];
+    if (!target) continue;
     ++all[static_cast<size_t>(c.slice)];
     // Dilated images are continuous: pixel index = element index.
     if (landing[n] < 0) continue;
-    if (seen && seen->ptr<uint8_t>()[landing[n]]) {
+    if (seen_pixels && seen_pixels[landing[n]]) {
       ++all_seen[static_cast<size_t>(c.slice)];
       if (s) ++s->seen;
     }
-    if (!dilated[static_cast<size_t>(i)].ptr<uint8_t>()[landing[n]]) {
-      const bool against = c.telling && enclosure && enclosure->encloses(landing[n], i);
+    if (!target[landing[n]]) {
+      const bool against = c.telling && enclosure && enclosure->encloses(landing[n], c.slice + offset);
       t.contradicted += against;
       if (s) s->contradicted += against;
       continue;
