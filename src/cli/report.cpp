@@ -312,7 +312,8 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
       j["candidate_decision"] = {{"answer", v.answer >= 0 ? nlohmann::json(v.answer) : nlohmann::json()},
                                  {"on", onName(v.on)},
                                  {"lead_sigma", v.lead_sigma},
-                                 {"slices", v.slices}};
+                                 {"slices", v.slices},
+                                 {"compared_at", {v.compared_at.x(), v.compared_at.y()}}};
       if (v.answer < 0) j["candidate_decision"]["reason"] = v.reason;
     }
     if (json_to_stdout) {

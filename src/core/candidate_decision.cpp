@@ -95,6 +95,7 @@ double pairedLeadSigma(const std::vector<double>& differences) {
 CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, const MatchParams& params, double grid,
                                     const Eigen::Vector2d& source_centre) {
   CandidateVerdict v;
+  v.compared_at = source_centre;
   if (candidates.empty()) {
     v.reason = "no candidate pose";
     return v;

@@ -25,6 +25,9 @@ struct CandidateVerdict {
   double lead_sigma = 0;  ///< the answer's lead over the best candidate elsewhere [normal sigmas]
   int slices = 0;         ///< the slices it was measured over
   std::string reason;     ///< why there is no answer
+  /// Where two candidates' places were compared: the source raster's centre,
+  /// in the source's frame [m].
+  Eigen::Vector2d compared_at = Eigen::Vector2d::Zero();
 };
 
 const char* onName(CandidateVerdict::On on);
