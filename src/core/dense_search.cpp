@@ -122,8 +122,17 @@ std::vector<int> landings(const std::vector<Cell>& cells, const Rigid2D& T, cons
   for (const Cell& c : cells) {
     const Eigen::Vector2d q = move(c.p);
     const Eigen::Vector2d f = grid.toPixel(q.x(), q.y());
-    const int u = static_cast<int>(std::lround(f.x())), v = static_cast<int>(std::lround(f.y()));
-    out.push_back(u < 0 || v < 0 || u >= grid.width || v >= grid.height ? -1 : v * grid.width + u);
+    // Rounded half away from zero as std::lround rounds, without its call (a
+    // tenth of the landing's time): at or below -0.5 pixels a position is off
+    // the raster whatever it rounds to, and above it truncating f + 0.5 rounds
+    // alike (but for the one double just below each half, which the sum rounds up).
+    const double fu = f.x() + 0.5, fv = f.y() + 0.5;
+    if (!(fu > 0 && fv > 0)) {
+      out.push_back(-1);
+      continue;
+    }
+    const int u = static_cast<int>(fu), v = static_cast<int>(fv);
+    out.push_back(u >= grid.width || v >= grid.height ? -1 : v * grid.width + u);
   }
   return out;
 }

