@@ -72,7 +72,15 @@ std::pair<double, int> votesLead(const Candidate& a, const Candidate& b) {
 }  // namespace
 
 const char* onName(CandidateVerdict::On on) {
-  return on == CandidateVerdict::On::occupancy ? "occupancy" : "feature_votes";
+  switch (on) {
+    case CandidateVerdict::On::occupancy:
+      return "occupancy";
+    case CandidateVerdict::On::corroborated:
+      return "corroborated";
+    case CandidateVerdict::On::feature_votes:
+      return "feature_votes";
+  }
+  return "?";
 }
 
 double pairedLeadSigma(const std::vector<double>& differences) {
@@ -138,6 +146,25 @@ CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, co
                  ? "no candidate elsewhere to weigh the best against"
                  : "the candidate that lands the most leads the best elsewhere by " + fixed(lead.first, 1) +
                        " sigma over " + std::to_string(lead.second) + " slices (need " + fixed(kClearSigma, 0) + ")";
+
+  // Corroboration: where the occupancy ranks one place first both among the
+  // candidates and in a dense search of every pose (that search's own best
+  // lies there), one of the features' slice-pair estimates agreeing with it
+  // is evidence of another kind, found on descriptors alone. A small map's
+  // occupancy often places a right answer no more clearly than a copy of it
+  // a few cells along a wall; the features, which do not slide, tell them apart.
+  const bool dense_best_here = std::any_of(candidates.begin(), candidates.end(), [&](const Candidate& c) {
+    return isDenseSearch(c.from) && c.rank == 0 && samePlace(c, candidates[best]);
+  });
+  if (dense_best_here && agreeing[best] > 0) {
+    v.answer = static_cast<int>(best);
+    v.on = CandidateVerdict::On::corroborated;
+    v.lead_sigma = lead.first, v.slices = lead.second;
+    v.reason.clear();
+    return v;
+  }
+  v.reason += dense_best_here ? "; no slice-pair estimate of the features agrees with it"
+                              : "; no dense search's best pose is at its place";
 
   // The features' evidence, where the occupancy does not tell (a street's
   // poses along its facades land alike): answered only where the occupancy

@@ -19,9 +19,11 @@ inline constexpr double kClearSigma = 3.0;
 /// What the decision over the candidates says.
 struct CandidateVerdict {
   int answer = -1;  ///< index into the candidates; -1: no reliable match
-  /// The evidence it answered on: the occupancy the candidate lands on, or,
-  /// where that does not tell, the features' slice-pair estimates it agrees with.
-  enum class On { occupancy, feature_votes } on = On::occupancy;
+  /// The evidence it answered on: the occupancy the candidate lands on; or,
+  /// where that does not tell, the occupancy's best place corroborated by a
+  /// dense search's best pose and a feature estimate there; or the features'
+  /// slice-pair estimates it agrees with.
+  enum class On { occupancy, corroborated, feature_votes } on = On::occupancy;
   double lead_sigma = 0;  ///< the answer's lead over the best candidate elsewhere [normal sigmas]
   int slices = 0;         ///< the slices it was measured over
   std::string reason;     ///< why there is no answer
@@ -45,6 +47,8 @@ double pairedLeadSigma(const std::vector<double>& differences);
 /// cells less twice the contradicted ones, slice by slice, on occupancy pooled
 /// to DenseSearchParams::finest_empty_cell where the grid is finer) answers if
 /// it leads the best candidate elsewhere by kClearSigma over the slices; else
+/// it answers as well where a dense search's best pose lies at its place and
+/// at least one of the features' slice-pair estimates agrees with it; else
 /// the one the most slice-pair estimates agree with answers if it leads the
 /// most agreed-with elsewhere by kClearSigma, source slice by source slice,
 /// and no candidate elsewhere lands kClearSigma more.

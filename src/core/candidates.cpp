@@ -58,6 +58,11 @@ const char* fromName(Candidate::From from) {
   return "?";
 }
 
+bool isDenseSearch(Candidate::From from) {
+  return from == Candidate::From::search_at_grid || from == Candidate::From::search_wide ||
+         from == Candidate::From::search_pooled;
+}
+
 std::optional<Candidate::From> fromName(const std::string& name) {
   for (const Candidate::From from :
        {Candidate::From::features, Candidate::From::feature_rival, Candidate::From::search_at_grid,

@@ -37,6 +37,8 @@ struct Candidate {
 };
 
 const char* fromName(Candidate::From from);
+/// Whether `from` is a dense search of the occupancy (not the features).
+bool isDenseSearch(Candidate::From from);
 /// The inverse: the search a name names; empty for any other text.
 std::optional<Candidate::From> fromName(const std::string& name);
 

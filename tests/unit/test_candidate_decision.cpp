@@ -94,3 +94,40 @@ TEST(CandidateDecision, EmptySpaceTheOtherMapSawCountsAgainstAPose) {
   const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero());
   EXPECT_EQ(v.answer, 1) << v.reason;
 }
+
+TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatureEstimateFindItToo) {
+  const MatchParams p = atTenCentimetres();
+  // An RGB-D crop: the right pose and a copy of it 0.6 m along a wall land
+  // almost alike over few slices, not clear of each other.
+  Candidate right = landing(0, 0, 0, 6, {62, 55, 70}), along = landing(0.6, 0, 0, 6, {60, 56, 66});
+  right.from = Candidate::From::search_wide;
+  along.from = Candidate::From::search_pooled;
+  right.feature_votes = {0, 1, 0};
+  CandidateVerdict v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero());
+  ASSERT_EQ(v.answer, 0) << v.reason;
+  EXPECT_EQ(v.on, CandidateVerdict::On::corroborated);
+  EXPECT_LT(v.lead_sigma, kClearSigma) << "the occupancy alone does not tell them apart";
+
+  // No slice-pair estimate there: the occupancy's word alone, which is not clear.
+  Candidate unvoted = right;
+  unvoted.feature_votes.clear();
+  v = decideOnCandidates({unvoted, along}, p, 0.1, Eigen::Vector2d::Zero());
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_NE(v.reason.find("no slice-pair estimate of the features agrees"), std::string::npos) << v.reason;
+
+  // The dense search's own best is the copy along the wall (rank 0), this is
+  // its runner-up: the two looks at the occupancy disagree.
+  Candidate runner_up = right;
+  runner_up.rank = 1;
+  along.rank = 0;
+  v = decideOnCandidates({runner_up, along}, p, 0.1, Eigen::Vector2d::Zero());
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_NE(v.reason.find("no dense search's best pose is at its place"), std::string::npos) << v.reason;
+
+  // The features' own answer is not a dense search: it corroborates nothing by itself.
+  Candidate from_features = right;
+  from_features.from = Candidate::From::features;
+  along.rank = 1;
+  v = decideOnCandidates({from_features, along}, p, 0.1, Eigen::Vector2d::Zero());
+  EXPECT_EQ(v.answer, -1) << v.reason;
+}
