@@ -163,8 +163,11 @@ CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, co
     v.reason.clear();
     return v;
   }
-  v.reason += dense_best_here ? "; no slice-pair estimate of the features agrees with it"
-                              : "; no dense search's best pose is at its place";
+  const bool searched =
+      std::any_of(candidates.begin(), candidates.end(), [](const Candidate& c) { return isDenseSearch(c.from); });
+  v.reason += !searched         ? "; no dense search of the occupancy to corroborate it"
+              : dense_best_here ? "; no slice-pair estimate of the features agrees with it"
+                                : "; no dense search's best pose is at its place";
 
   // The features' evidence, where the occupancy does not tell (a street's
   // poses along its facades land alike): answered only where the occupancy

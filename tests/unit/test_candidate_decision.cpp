@@ -128,6 +128,8 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   Candidate from_features = right;
   from_features.from = Candidate::From::features;
   along.rank = 1;
+  along.from = Candidate::From::feature_rival;
   v = decideOnCandidates({from_features, along}, p, 0.1, Eigen::Vector2d::Zero());
-  EXPECT_EQ(v.answer, -1) << v.reason;
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_NE(v.reason.find("no dense search of the occupancy"), std::string::npos) << v.reason;
 }
