@@ -122,10 +122,11 @@ std::vector<int> landings(const std::vector<Cell>& cells, const Rigid2D& T, cons
   for (const Cell& c : cells) {
     const Eigen::Vector2d q = move(c.p);
     const Eigen::Vector2d f = grid.toPixel(q.x(), q.y());
-    // Rounded half away from zero as std::lround rounds, without its call (a
-    // tenth of the landing's time): at or below -0.5 pixels a position is off
-    // the raster whatever it rounds to, and above it truncating f + 0.5 rounds
-    // alike (but for the one double just below each half, which the sum rounds up).
+    // Rounded half away from zero as std::lround rounds, without its call (as
+    // long as the rest of the landing, `perf` on the slowest matrix pair): at
+    // or below -0.5 pixels a position is off the raster whatever it rounds
+    // to, and above it truncating f + 0.5 rounds alike (but for the one
+    // double just below each half, which the sum rounds up).
     const double fu = f.x() + 0.5, fv = f.y() + 0.5;
     if (!(fu > 0 && fv > 0)) {
       out.push_back(-1);

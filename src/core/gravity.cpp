@@ -200,8 +200,8 @@ Tilt measureTilt(const Points& map, double grid) {
 std::vector<Points> partsOf(const Points& map) {
   const size_t stride = std::max<size_t>(1, map.size() / kMaxPoints);
   // Every vector is sized before it is filled: growing one on huge pages
-  // faults in and clears its pages again at every reallocation (sized, the
-  // matrix's slowest indoor pairs take a fifth less time, whole match).
+  // faults its pages in and clears them again at every reallocation, which
+  // `perf` showed among the slowest matrix pair's costs.
   Points sample;
   sample.reserve(map.size() / stride + 1);
   for (size_t i = 0; i < map.size(); i += stride) sample.push_back(map[i]);
