@@ -149,7 +149,7 @@ cv::Mat drawSlicePairs(const MapFeatures& target, const MapFeatures& source, con
   }
   if (rows.empty()) {
     // A dense answer stands on the occupancy alone: no descriptor matches lie behind it.
-    const bool dense = r.reliable && r.answered_by != Candidate::From::features;
+    const bool dense = r.reliable && isDenseSearch(r.answered_by);
     cv::Mat none(80, 1000, CV_8UC3, colour::kWhite);
     drawText(none,
              dense ? "found by the dense search of the occupancy, not by descriptor matches: see the overlay"
