@@ -209,6 +209,11 @@ std::vector<std::optional<GroundTruthCheck>> candidateChecks(const MatchResult& 
   return out;
 }
 
+/// A candidate's error against the truth, as `error` is for the answer (without its origin error).
+nlohmann::json candidateErrorJson(const GroundTruthCheck& check) {
+  return {{"translation", check.error.translation}, {"yaw", check.error.yaw}, {"success", check.success()}};
+}
+
 nlohmann::json landedJson(const DensePose& p) {
   return {{"x", p.transform.t.x()},
           {"y", p.transform.t.y()},
@@ -246,10 +251,7 @@ nlohmann::json candidatesJson(const MatchResult& r, const std::vector<std::optio
         if (c.feature_votes[k] > 0) votes.push_back({k, c.feature_votes[k]});
       j["feature_votes"] = votes;
     }
-    if (checks[i])
-      j["error"] = {{"translation", checks[i]->error.translation},
-                    {"yaw", checks[i]->error.yaw},
-                    {"success", checks[i]->success()}};
+    if (checks[i]) j["error"] = candidateErrorJson(*checks[i]);
     out.push_back(j);
   }
   return out;
@@ -258,7 +260,8 @@ nlohmann::json candidatesJson(const MatchResult& r, const std::vector<std::optio
 /// The candidates, best refined score first: where each came from, its score
 /// as proposed and refined, and its error where the truth is known.
 void printCandidates(std::ostream& out, const MatchResult& r,
-                     const std::vector<std::optional<GroundTruthCheck>>& checks) {
+                     const std::vector<std::optional<GroundTruthCheck>>& checks,
+                     const std::optional<GroundTruthCheck>& finished_check) {
   std::vector<size_t> order(r.candidates.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
@@ -283,6 +286,9 @@ void printCandidates(std::ostream& out, const MatchResult& r,
     out << format("one decision     (on trial, not the answer) %s (%d), %.1f sigma clear on %s over %d slices\n",
                   fromName(r.candidates[static_cast<size_t>(v.answer)].from),
                   r.candidates[static_cast<size_t>(v.answer)].rank, v.lead_sigma, onName(v.on), v.slices);
+  if (finished_check)
+    out << format("                 finished in 6-DoF: error %.3f m, %.4f rad: %s\n", finished_check->error.translation,
+                  finished_check->error.yaw, finished_check->success() ? "right" : "wrong");
 }
 
 }  // namespace
@@ -292,13 +298,16 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
   std::optional<GroundTruthCheck> gt;
   if (truth) gt = checkAgainstGroundTruth(r, *truth, grid);
   const std::vector<std::optional<GroundTruthCheck>> checks = candidateChecks(r, truth, grid);
+  std::optional<GroundTruthCheck> finished_check;  // the decision on trial's answer, finished
+  if (truth && r.candidate_verdict && r.candidate_verdict->finished)
+    finished_check = checkAgainstGroundTruth(*r.candidate_verdict->finished, *truth, grid);
   const bool json_to_stdout = how.json == "-";
   std::ostream& text = json_to_stdout ? std::cerr : std::cout;
   if (how.quiet)
     text << resultLine(r) << "\n";
   else
     printResult(text, r, gt, how.method);
-  if (!how.quiet && !r.candidates.empty()) printCandidates(text, r, checks);
+  if (!how.quiet && !r.candidates.empty()) printCandidates(text, r, checks, finished_check);
   if (!how.json.empty()) {
     auto j = toJson(r, gt);
     j["schema_version"] = kJsonSchemaVersion;
@@ -315,6 +324,8 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
                                  {"slices", v.slices},
                                  {"compared_at", {v.compared_at.x(), v.compared_at.y()}}};
       if (v.answer < 0) j["candidate_decision"]["reason"] = v.reason;
+      if (v.finished) j["candidate_decision"]["finished"] = true;
+      if (finished_check) j["candidate_decision"]["finished_error"] = candidateErrorJson(*finished_check);
     }
     if (json_to_stdout) {
       std::cout << j.dump(2) << "\n";

@@ -3,6 +3,7 @@
 // until it answers the regression matrix as well: the best candidate answers
 // when its lead over the best candidate elsewhere, slice by slice, is beyond
 // chance (docs/algorithm.md, "One decision, on trial").
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,10 @@ struct CandidateVerdict {
   /// Where two candidates' places were compared: the source raster's centre,
   /// in the source's frame [m].
   Eigen::Vector2d compared_at = Eigen::Vector2d::Zero();
+  /// The answer finished in 6-DoF as the verdict's answer is (six_dof_finish.hpp),
+  /// as the whole transform between the maps' own frames; unset where the
+  /// finish did not run or did not hold.
+  std::optional<Eigen::Matrix4d> finished;
 };
 
 const char* onName(CandidateVerdict::On on);

@@ -233,18 +233,26 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   }
   settleMatch(r, e, target, source, params);
   Eigen::Matrix4d answer = r.T_target_source.matrix();  // between the levelled frames
+  SixDofFinishParams finish;
+  finish.threads = matchThreads(params);
   if (r.reliable && params.finish) {
     // The finish works on what the daemon has of a peer's map too: its
     // occupancy (empty there where the slices came without it: not held).
     const auto t0 = Clock::now();
-    SixDofFinishParams finish;
-    finish.threads = matchThreads(params);
     r.finish = finishSixDof(target.occupancy, source.occupancy, answer, finish);
     r.timings.finish = secondsSince(t0);
     if (r.finish->held) {
       answer = r.finish->T_target_source;
       r.T_target_source = fourDofAbout(answer, occupancyCentre(source.occupancy));
     }
+  }
+  if (r.candidate_verdict && r.candidate_verdict->answer >= 0 && params.finish) {
+    // The decision on trial's answer, finished as the verdict's is.
+    const Candidate& c = r.candidates[static_cast<size_t>(r.candidate_verdict->answer)];
+    const SixDofFinish f = finishSixDof(target.occupancy, source.occupancy,
+                                        poseAt(c.landed.transform, c.landed.offset, target, source).matrix(), finish);
+    if (f.held)
+      r.candidate_verdict->finished = betweenOwnFrames(f.T_target_source, target.slicedUp(), source.slicedUp());
   }
   if (target.leveled || source.leveled || (r.finish && r.finish->held))
     r.T_target_source_6dof = betweenOwnFrames(answer, target.slicedUp(), source.slicedUp());

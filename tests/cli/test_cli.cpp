@@ -320,6 +320,12 @@ TEST(Cli, CandidatesListEveryProposedPoseScoredWithItsError) {
   EXPECT_TRUE(j["candidates"].at(trial["answer"].get<size_t>())["error"]["success"].get<bool>()) << trial.dump();
   EXPECT_GE(trial["lead_sigma"].get<double>(), 3.0);
   EXPECT_NE(r.output.find("one decision     (on trial, not the answer)"), std::string::npos) << r.output;
+  // Its answer is finished in 6-DoF as the verdict's is, and judged so: a
+  // level room's right answer stays right and within a cell of the truth.
+  ASSERT_TRUE(trial.value("finished", false)) << trial.dump();
+  EXPECT_TRUE(trial["finished_error"]["success"].get<bool>()) << trial.dump();
+  EXPECT_LT(trial["finished_error"]["translation"].get<double>(), 0.1) << trial.dump();
+  EXPECT_NE(r.output.find("finished in 6-DoF: error"), std::string::npos) << r.output;
   const auto plain = runTomomap("match " + w + "/map_0.pcd " + w + "/map_1.pcd --grid 0.1 --json " + (dir / "p.json"));
   EXPECT_FALSE(nlohmann::json::parse(std::ifstream(dir / "p.json")).contains("candidates")) << "only when asked";
 }
