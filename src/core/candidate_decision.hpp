@@ -45,6 +45,14 @@ const char* onName(CandidateVerdict::On on);
 /// t over 50. 0 for fewer than two differences or a mean at or below zero.
 double pairedLeadSigma(const std::vector<double>& differences);
 
+/// pairedLeadSigma for differences in slice order, lowest first, where
+/// neighbouring slices are not independent (they see the same walls): with
+/// their straight-line course with height taken out, the differences' lag-1
+/// autocorrelation rho (0 where negative) counts n slices as n (1 - rho) /
+/// (1 + rho) independent ones, at least 2 (the effective sample size of a
+/// first-order autoregressive series).
+double sliceLeadSigma(const std::vector<double>& differences);
+
 /// The decision over `candidates` (refineAndLand's, for maps of `grid` whose
 /// source raster is centred at `source_centre`). Two candidates are at the same
 /// place within one consensus tolerance at that centre, the consensus yaw and

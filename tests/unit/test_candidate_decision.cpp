@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/candidate_decision.hpp"
 
 using namespace tomomap;
@@ -38,6 +40,24 @@ TEST(CandidateDecision, ALeadCountsByItsSlicesSpreadAndNumber) {
   std::vector<double> spread;
   for (int k = 0; k < 50; ++k) spread.push_back(k % 2 ? 2.0 + 4.08 : 2.0 - 4.08);
   EXPECT_NEAR(pairedLeadSigma(spread), 3.23, 0.02);  // t = 3.43, 49 degrees of freedom
+}
+
+// Neighbouring slices see the same walls: a lead that rises and falls
+// slowly with height is fewer independent looks than its slices.
+TEST(CandidateDecision, SlicesThatEchoEachOtherCountForFewer) {
+  std::vector<double> wave, shuffled;
+  for (int k = 0; k < 30; ++k) wave.push_back(1.0 + 2.0 * std::sin(k / 4.0));
+  for (int k = 0; k < 30; ++k) shuffled.push_back(wave[static_cast<size_t>(k % 2 ? k / 2 : 29 - k / 2)]);
+  EXPECT_NEAR(pairedLeadSigma(wave), pairedLeadSigma(shuffled), 1e-9) << "the paired test does not see the order";
+  EXPECT_GE(pairedLeadSigma(wave), 3.0);
+  EXPECT_LT(sliceLeadSigma(wave), 1.5) << "a slow wave is a few looks, not 30";
+  EXPECT_GT(sliceLeadSigma(shuffled), sliceLeadSigma(wave));
+  // A lead that grows steadily with height is a difference in the mean, not
+  // an echo: the straight line is taken out before the slices are compared.
+  std::vector<double> ramp;
+  for (int k = 0; k < 30; ++k) ramp.push_back(1.0 + 0.1 * k + (k % 2 ? 0.5 : -0.5));
+  EXPECT_DOUBLE_EQ(sliceLeadSigma(ramp), pairedLeadSigma(ramp));
+  EXPECT_DOUBLE_EQ(sliceLeadSigma({1.0, 2.0, 3.0}), pairedLeadSigma({1.0, 2.0, 3.0})) << "too few to tell";
 }
 
 TEST(CandidateDecision, TheBestAnswersWhereItLeadsEveryPlaceElsewhereBeyondChance) {
