@@ -1,20 +1,16 @@
 #include "candidate_decision.hpp"
 
 #include <algorithm>
-#include <boost/math/distributions/normal.hpp>
-#include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 #include <map>
 #include <set>
 
 #include "height_offsets.hpp"
+#include "lead_sigma.hpp"
 #include "text.hpp"
 
 namespace tomomap {
 namespace {
-
-/// A lead whose chance probability is below double's range reads as this many sigmas.
-constexpr double kMostSigma = 37.0;
 
 /// Per slice: what a candidate lands there (telling cells less twice those in
 /// space the target saw empty) and its telling cells.
@@ -41,7 +37,9 @@ int votes(const Candidate& c) {
 
 /// `a`'s lead over `b` on the occupancy, slice by slice: each slice's
 /// difference per telling cell (the larger of the two), so that every slice
-/// weighs alike whatever its size.
+/// weighs alike whatever its size. Slices with no telling cell on either are
+/// left out; the rest are neighbours in sliceLeadSigma's series, as the
+/// slices of a wall's height are.
 std::pair<double, int> occupancyLead(const SliceScores& a, const SliceScores& b) {
   std::set<int> slices;
   for (const auto& [k, v] : a) slices.insert(k);
@@ -81,59 +79,6 @@ const char* onName(CandidateVerdict::On on) {
       return "feature_votes";
   }
   return "?";
-}
-
-namespace {
-
-/// pairedLeadSigma with the differences worth `independent` independent ones
-/// (at most their number): the standard error and the t's degrees of
-/// freedom follow from that many.
-double leadSigma(const std::vector<double>& differences, double independent) {
-  const size_t n = differences.size();
-  if (n < 2) return 0.0;
-  double mean = 0;
-  for (double x : differences) mean += x;
-  mean /= static_cast<double>(n);
-  if (mean <= 0) return 0.0;
-  double ss = 0;
-  for (double x : differences) ss += (x - mean) * (x - mean);
-  const double se = std::sqrt(ss / static_cast<double>(n - 1) / independent);
-  if (se <= 0) return kMostSigma;
-  const double tail = boost::math::cdf(boost::math::complement(boost::math::students_t(independent - 1), mean / se));
-  if (!(tail > 1e-300)) return kMostSigma;
-  return std::min(kMostSigma, boost::math::quantile(boost::math::complement(boost::math::normal(), tail)));
-}
-
-}  // namespace
-
-double pairedLeadSigma(const std::vector<double>& differences) {
-  return leadSigma(differences, static_cast<double>(differences.size()));
-}
-
-double sliceLeadSigma(const std::vector<double>& differences) {
-  const size_t n = differences.size();
-  if (n < 4) return pairedLeadSigma(differences);
-  // What is left of each slice's difference once the lead's straight-line
-  // course with height is taken out: the lead may grow towards a furnished
-  // floor, which is a difference in the mean, not slices echoing each other.
-  const double mid = (static_cast<double>(n) - 1) / 2;
-  double mean = 0, sxx = 0, sxy = 0;
-  for (double x : differences) mean += x;
-  mean /= static_cast<double>(n);
-  for (size_t k = 0; k < n; ++k) {
-    sxx += (static_cast<double>(k) - mid) * (static_cast<double>(k) - mid);
-    sxy += (static_cast<double>(k) - mid) * (differences[k] - mean);
-  }
-  std::vector<double> left(n);
-  for (size_t k = 0; k < n; ++k) left[k] = differences[k] - mean - sxy / sxx * (static_cast<double>(k) - mid);
-  double lagged = 0, squares = 0;
-  for (size_t k = 0; k < n; ++k) {
-    squares += left[k] * left[k];
-    if (k + 1 < n) lagged += left[k] * left[k + 1];
-  }
-  const double rho = squares > 0 ? std::clamp(lagged / squares, 0.0, 1.0) : 0.0;
-  const double independent = std::max(2.0, static_cast<double>(n) * (1 - rho) / (1 + rho));
-  return leadSigma(differences, independent);
 }
 
 CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, const MatchParams& params, double grid,

@@ -1,6 +1,6 @@
 #pragma once
 // One decision over the candidates, on trial beside the verdict (verdict.hpp)
-// until it answers the regression matrix as well: the best candidate answers
+// until it may replace it (docs/algorithm.md, "One decision, on trial"): the best candidate answers
 // when its lead over the best candidate elsewhere, slice by slice, is beyond
 // chance (docs/algorithm.md, "One decision, on trial").
 #include <optional>
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "candidates.hpp"
+#include "lead_sigma.hpp"
 
 namespace tomomap {
 
@@ -38,20 +39,6 @@ struct CandidateVerdict {
 };
 
 const char* onName(CandidateVerdict::On on);
-
-/// How far the mean of `differences` (one per slice) lies above zero, by a
-/// one-sided Student t test over them, as the normal deviate of the same
-/// tail probability: a lead over 3 slices counts for less than the same
-/// t over 50. 0 for fewer than two differences or a mean at or below zero.
-double pairedLeadSigma(const std::vector<double>& differences);
-
-/// pairedLeadSigma for differences in slice order, lowest first, where
-/// neighbouring slices are not independent (they see the same walls): with
-/// their straight-line course with height taken out, the differences' lag-1
-/// autocorrelation rho (0 where negative) counts n slices as n (1 - rho) /
-/// (1 + rho) independent ones, at least 2 (the effective sample size of a
-/// first-order autoregressive series).
-double sliceLeadSigma(const std::vector<double>& differences);
 
 /// The decision over `candidates` (refineAndLand's, for maps of `grid` whose
 /// source raster is centred at `source_centre`). Two candidates are at the same

@@ -247,12 +247,15 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
     }
   }
   if (r.candidate_verdict && r.candidate_verdict->answer >= 0 && params.finish) {
-    // The decision on trial's answer, finished as the verdict's is.
+    // The decision on trial's answer, finished as the verdict's is (its time
+    // counted with the finish's).
+    const auto t0 = Clock::now();
     const Candidate& c = r.candidates[static_cast<size_t>(r.candidate_verdict->answer)];
     const SixDofFinish f = finishSixDof(target.occupancy, source.occupancy,
                                         poseAt(c.landed.transform, c.landed.offset, target, source).matrix(), finish);
     if (f.held)
       r.candidate_verdict->finished = betweenOwnFrames(f.T_target_source, target.slicedUp(), source.slicedUp());
+    r.timings.finish += secondsSince(t0);
   }
   if (target.leveled || source.leveled || (r.finish && r.finish->held))
     r.T_target_source_6dof = betweenOwnFrames(answer, target.slicedUp(), source.slicedUp());

@@ -1,0 +1,23 @@
+#pragma once
+// How clearly one candidate leads another over a series of differences (one
+// per slice or source slice), as the normal deviate of a one-sided t test's
+// tail: the decision over the candidates' one yardstick (candidate_decision.hpp).
+#include <vector>
+
+namespace tomomap {
+
+/// How far the mean of `differences` (one per slice) lies above zero, by a
+/// one-sided Student t test over them, as the normal deviate of the same
+/// tail probability: a lead over 3 slices counts for less than the same
+/// t over 50. 0 for fewer than two differences or a mean at or below zero.
+double pairedLeadSigma(const std::vector<double>& differences);
+
+/// pairedLeadSigma for differences in slice order, lowest first, where
+/// neighbouring slices are not independent (they see the same walls): with
+/// their straight-line course with height taken out, the differences' lag-1
+/// autocorrelation rho (0 where negative) counts n slices as n (1 - rho) /
+/// (1 + rho) independent ones, at least 2 (the effective sample size of a
+/// first-order autoregressive series). Below 4 slices, pairedLeadSigma.
+double sliceLeadSigma(const std::vector<double>& differences);
+
+}  // namespace tomomap
