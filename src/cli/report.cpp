@@ -214,6 +214,12 @@ nlohmann::json candidateErrorJson(const GroundTruthCheck& check) {
   return {{"translation", check.error.translation}, {"yaw", check.error.yaw}, {"success", check.success()}};
 }
 
+/// The same in the candidates' text lines.
+std::string candidateErrorText(const GroundTruthCheck& check) {
+  return format("error %.3f m, %.4f rad: %s", check.error.translation, check.error.yaw,
+                check.success() ? "right" : "wrong");
+}
+
 nlohmann::json landedJson(const DensePose& p) {
   return {{"x", p.transform.t.x()},
           {"y", p.transform.t.y()},
@@ -273,9 +279,7 @@ void printCandidates(std::ostream& out, const MatchResult& r,
     const Candidate& c = r.candidates[i];
     out << format("  %-15s (%d) %9.0f -> %9.0f  %3d (%3d)  %6zu", fromName(c.from), c.rank, c.proposed_landed.score(),
                   c.landed.score(), c.landed.support, c.landed.support_seen, c.landed.contradicted);
-    if (checks[i])
-      out << format("  error %.3f m, %.4f rad: %s", checks[i]->error.translation, checks[i]->error.yaw,
-                    checks[i]->success() ? "right" : "wrong");
+    if (checks[i]) out << "  " << candidateErrorText(*checks[i]);
     out << "\n";
   }
   if (!r.candidate_verdict) return;
@@ -286,9 +290,7 @@ void printCandidates(std::ostream& out, const MatchResult& r,
     out << format("one decision     (on trial, not the answer) %s (%d), %.1f sigma clear on %s over %d slices\n",
                   fromName(r.candidates[static_cast<size_t>(v.answer)].from),
                   r.candidates[static_cast<size_t>(v.answer)].rank, v.lead_sigma, onName(v.on), v.slices);
-  if (finished_check)
-    out << format("                 finished in 6-DoF: error %.3f m, %.4f rad: %s\n", finished_check->error.translation,
-                  finished_check->error.yaw, finished_check->success() ? "right" : "wrong");
+  if (finished_check) out << "                 finished in 6-DoF: " << candidateErrorText(*finished_check) << "\n";
 }
 
 }  // namespace

@@ -1,14 +1,13 @@
 #pragma once
 // One decision over the candidates, on trial beside the verdict (verdict.hpp)
-// until it may replace it (docs/algorithm.md, "One decision, on trial"): the best candidate answers
-// when its lead over the best candidate elsewhere, slice by slice, is beyond
-// chance (docs/algorithm.md, "One decision, on trial").
+// until it may replace it: the best candidate answers when its lead over the
+// best candidate elsewhere, slice by slice, is beyond chance
+// (docs/algorithm.md, "One decision, on trial").
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "candidates.hpp"
-#include "lead_sigma.hpp"
 
 namespace tomomap {
 

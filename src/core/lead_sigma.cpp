@@ -39,9 +39,9 @@ double pairedLeadSigma(const std::vector<double>& differences) {
 double sliceLeadSigma(const std::vector<double>& differences) {
   const size_t n = differences.size();
   if (n < 4) return pairedLeadSigma(differences);
-  // Each slice's difference less the lead's straight-line
-  // course with height: the lead may grow towards a furnished
-  // floor, which is a difference in the mean, not slices echoing each other.
+  // Each slice's difference less the lead's straight-line course with
+  // height: the lead may grow towards a furnished floor, which is a
+  // difference in the mean, not slices echoing each other.
   const double mid = (static_cast<double>(n) - 1) / 2;
   double mean = 0, sxx = 0, sxy = 0;
   for (double x : differences) mean += x;
