@@ -77,7 +77,7 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
   if (target.occupancy.partial || source.occupancy.partial || proposals.empty()) return {};
   DenseSearchParams dp;
   dp.threads = matchThreads(params);
-  const PoseLander land = poseLander(target.occupancy, source.occupancy, dp);
+  const PoseLander land(target.occupancy, source.occupancy, dp);
   std::vector<std::pair<Rigid2D, int>> poses;
   for (const Proposal& p : proposals) poses.emplace_back(p.T, p.offset);
   const std::vector<DensePose> as_proposed = land(poses);

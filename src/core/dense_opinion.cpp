@@ -132,7 +132,7 @@ void climbUphill(MatchResult& r, const std::vector<std::pair<Rigid2D, int>>& fou
     if (onePlace(T, offset, answer, r.height_offset, same, source.occupancy.grid.centre()))
       starts.emplace_back(T, offset);
   // One preparation of the occupancy lands the starts and serves the climb.
-  const PoseLander land = poseLander(target.occupancy, source.occupancy, dp);
+  const PoseLander land(target.occupancy, source.occupancy, dp);
   const std::vector<DensePose> landed = land(starts);
   if (landed.empty()) return;
   const DensePose* start = &landed.front();

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
+#include <map>
 #include <memory>
 #include <opencv2/imgproc.hpp>
 #include <optional>
+#include <tuple>
 
 #include "dense_refine.hpp"
 #include "spectrum_correlation.hpp"
@@ -216,12 +219,19 @@ cv::Mat footprint(const SliceStack& stack, const std::vector<cv::Mat>& dilated) 
   return out;
 }
 
+std::vector<Cell> tellingOf(const std::vector<Cell>& cells) {
+  std::vector<Cell> out;
+  std::copy_if(cells.begin(), cells.end(), std::back_inserter(out), [](const Cell& c) { return c.telling; });
+  return out;
+}
+
 /// What a pose is judged on, built once per pair of maps: both maps' dilated
 /// occupancy, their cells and the space each saw empty.
 struct PoseJudge {
   const SliceStack &target, &source;
   std::vector<cv::Mat> dilated, source_dilated;
   std::vector<Cell> source_cells, target_cells;
+  std::vector<Cell> source_telling, target_telling;  ///< the telling ones alone: all a score counts
   Enclosure target_encloses, source_encloses;
   cv::Mat target_seen;
   const Enclosure *in_target, *in_source;  ///< null on cells too fine to read empty space
@@ -233,6 +243,8 @@ struct PoseJudge {
         source_dilated(dilatedSlices(s, params)),
         source_cells(cellsOf(s, params.wall_spread)),
         target_cells(cellsOf(t, params.wall_spread)),
+        source_telling(tellingOf(source_cells)),
+        target_telling(tellingOf(target_cells)),
         target_encloses(t),
         source_encloses(s),
         target_seen(footprint(t, dilated)),
@@ -243,18 +255,44 @@ struct PoseJudge {
   Tally forth(const std::vector<int>& landing, int offset) const {
     return countInliers(dilated, source_cells, landing, offset, source.size(), in_target, &target_seen);
   }
-  /// Sets p's tally from the source's cells landed on the target (at `landing`)
-  /// and adds the target's landed back on the source: both ways.
-  void judge(DensePose& p, const Tally& there) const {
-    p.inliers = there.inliers, p.telling_inliers = there.telling, p.support = there.slices;
+  /// The target's cells landed back on the source (at `back`) at height `offset`.
+  Tally backwards(const std::vector<int>& back, int offset) const {
+    return countInliers(source_dilated, target_cells, back, -offset, target.size(), in_source);
+  }
+  /// Sets p's tally from the source's cells landed on the target (`there`)
+  /// and adds the target's landed back on the source (`here`): both ways.
+  static void judge(DensePose& p, const Tally& there, const Tally& here) {
+    p.inliers = there.inliers, p.telling_inliers = there.telling + here.telling, p.support = there.slices;
     p.support_seen = there.slices_seen;
-    p.contradicted = there.contradicted;
-    const std::vector<int> back = landings(target_cells, p.transform.inverse(), source.grid);
-    const Tally here = countInliers(source_dilated, target_cells, back, -p.offset, target.size(), in_source);
-    p.telling_inliers += here.telling;
-    p.contradicted += here.contradicted;
+    p.contradicted = there.contradicted + here.contradicted;
+  }
+  void judge(DensePose& p, const Tally& there) const {
+    judge(p, there, backwards(landings(target_cells, p.transform.inverse(), source.grid), p.offset));
+  }
+  /// p's score alone, on the telling cells both ways (what judge gives it).
+  double score(const Rigid2D& T, int offset, const std::vector<int>& forth_telling,
+               const std::vector<int>& back_telling) const {
+    DensePose p{T, offset, 0};
+    judge(p, countInliers(dilated, source_telling, forth_telling, offset, source.size(), in_target),
+          countInliers(source_dilated, target_telling, back_telling, -offset, target.size(), in_source));
+    return p.score();
   }
 };
+
+/// `poses` by transform: the indices of the poses of each distinct one (a
+/// climb's steps and a ring of shifts land each transform at three heights,
+/// and where a transform lands the cells does not depend on the height).
+std::vector<std::vector<size_t>> byTransform(const PoseLander::Poses& poses) {
+  std::map<std::tuple<double, double, double>, size_t> index;
+  std::vector<std::vector<size_t>> out;
+  for (size_t n = 0; n < poses.size(); ++n) {
+    const Rigid2D& T = poses[n].first;
+    const auto [at, added] = index.try_emplace({T.yaw, T.t.x(), T.t.y()}, out.size());
+    if (added) out.emplace_back();
+    out[at->second].push_back(n);
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -270,27 +308,53 @@ std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, cons
   return out;
 }
 
-PoseLander poseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params) {
-  if (target.partial || source.partial) return [](const auto&) { return std::vector<DensePose>{}; };
+PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params) {
+  if (target.partial || source.partial) {
+    land_ = [](const Poses&) { return std::vector<DensePose>{}; };
+    score_ = [](const Poses&) { return std::vector<double>{}; };
+    return;
+  }
   const auto judge = std::make_shared<const PoseJudge>(target, source, params);
   const int threads = std::max(1, params.threads);
-  return [judge, threads](const std::vector<std::pair<Rigid2D, int>>& poses) {
+  // Each distinct transform lands the cells once, both ways, for all its heights.
+  land_ = [judge, threads](const Poses& poses) {
     std::vector<DensePose> out(poses.size());
+    const std::vector<std::vector<size_t>> groups = byTransform(poses);
 #pragma omp parallel for schedule(dynamic) num_threads(threads)
-    for (size_t n = 0; n < poses.size(); ++n) {
-      const auto& [T, offset] = poses[n];
-      DensePose& p = out[n];
-      p.transform = T, p.offset = offset;
-      judge->judge(p, judge->forth(landings(judge->source_cells, T, judge->target.grid), offset));
+    for (size_t g = 0; g < groups.size(); ++g) {
+      const Rigid2D& T = poses[groups[g].front()].first;
+      const std::vector<int> forth = landings(judge->source_cells, T, judge->target.grid),
+                             back = landings(judge->target_cells, T.inverse(), judge->source.grid);
+      for (size_t n : groups[g]) {
+        DensePose& p = out[n];
+        p.transform = T, p.offset = poses[n].second;
+        PoseJudge::judge(p, judge->forth(forth, p.offset), judge->backwards(back, p.offset));
+      }
+    }
+    return out;
+  };
+  score_ = [judge, threads](const Poses& poses) {
+    std::vector<double> out(poses.size());
+    const std::vector<std::vector<size_t>> groups = byTransform(poses);
+#pragma omp parallel for schedule(dynamic) num_threads(threads)
+    for (size_t g = 0; g < groups.size(); ++g) {
+      const Rigid2D& T = poses[groups[g].front()].first;
+      const std::vector<int> forth = landings(judge->source_telling, T, judge->target.grid),
+                             back = landings(judge->target_telling, T.inverse(), judge->source.grid);
+      for (size_t n : groups[g]) out[n] = judge->score(T, poses[n].second, forth, back);
     }
     return out;
   };
 }
 
+std::vector<DensePose> PoseLander::operator()(const Poses& poses) const { return land_(poses); }
+
+std::vector<double> PoseLander::scores(const Poses& poses) const { return score_(poses); }
+
 std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& source,
                                  const std::vector<std::pair<Rigid2D, int>>& poses, const DenseSearchParams& params) {
   if (poses.empty()) return {};
-  return poseLander(target, source, params)(poses);
+  return PoseLander(target, source, params)(poses);
 }
 
 DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset) {
@@ -300,7 +364,7 @@ DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset) {
 
 DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                    const DenseSearchParams& params) {
-  return landPose(poseLander(target, source, params), T, offset);
+  return landPose(PoseLander(target, source, params), T, offset);
 }
 
 int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,

@@ -118,8 +118,21 @@ std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, cons
 /// landPoses with the maps' occupancy prepared once for every call, for a
 /// caller that lands poses again and again (a climb, nearby_poses.hpp). The
 /// stacks must outlive it.
-using PoseLander = std::function<std::vector<DensePose>(const std::vector<std::pair<Rigid2D, int>>&)>;
-PoseLander poseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params = {});
+class PoseLander {
+ public:
+  using Poses = std::vector<std::pair<Rigid2D, int>>;  ///< (T, offset) each
+  PoseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params = {});
+  /// Each pose landed (landPose); empty where either stack is partial.
+  std::vector<DensePose> operator()(const Poses& poses) const;
+  /// Each pose's DensePose::score() alone, counted on the telling cells alone
+  /// (the only ones it weighs): for a caller that ranks many poses and lands
+  /// only the best (a climb, nearby_poses.hpp). Empty where either stack is partial.
+  std::vector<double> scores(const Poses& poses) const;
+
+ private:
+  std::function<std::vector<DensePose>(const Poses&)> land_;
+  std::function<std::vector<double>(const Poses&)> score_;
+};
 
 /// landPose with a lander: (T, offset) landed, nothing landed (all counts 0)
 /// where `land` lands nothing.

@@ -12,26 +12,26 @@ namespace {
 /// cells, so a climb ends on its own within the poses the maps allow.
 constexpr int kMaxSteps = 200, kMaxRefinements = 10;
 
-DensePose best(const std::vector<DensePose>& landed) {
-  return *std::max_element(landed.begin(), landed.end(),
-                           [](const DensePose& a, const DensePose& b) { return a.score() < b.score(); });
+/// The index of the first of the highest scores.
+size_t best(const std::vector<double>& scores) {
+  return static_cast<size_t>(std::max_element(scores.begin(), scores.end()) - scores.begin());
 }
 
-/// The poses one step from `p` (uphill's steps).
-std::vector<std::pair<Rigid2D, int>> stepsFrom(const DensePose& p, double cell, double yaw_step,
-                                               const Eigen::Vector2d& centre) {
-  std::vector<std::pair<Rigid2D, int>> steps;
-  const Eigen::Vector2d pivot = p.transform.apply(centre);
-  for (int o = p.offset - 1; o <= p.offset + 1; ++o) {
-    if (o != p.offset) steps.emplace_back(p.transform, o);
+/// The poses one step from (from, offset): uphill's steps.
+PoseLander::Poses stepsFrom(const Rigid2D& from, int offset, double cell, double yaw_step,
+                            const Eigen::Vector2d& centre) {
+  PoseLander::Poses steps;
+  const Eigen::Vector2d pivot = from.apply(centre);
+  for (int o = offset - 1; o <= offset + 1; ++o) {
+    if (o != offset) steps.emplace_back(from, o);
     for (int sign : {-1, 1}) {
-      Rigid2D T = p.transform;
+      Rigid2D T = from;
       T.t.x() += sign * cell;
       steps.emplace_back(T, o);
-      T = p.transform;
+      T = from;
       T.t.y() += sign * cell;
       steps.emplace_back(T, o);
-      T.yaw = p.transform.yaw + sign * yaw_step;
+      T.yaw = from.yaw + sign * yaw_step;
       T.t = pivot - Rigid2D{T.yaw, Eigen::Vector2d::Zero()}.apply(centre);
       steps.emplace_back(T, o);
     }
@@ -40,17 +40,23 @@ std::vector<std::pair<Rigid2D, int>> stepsFrom(const DensePose& p, double cell, 
 }
 
 /// `p` moved one step at a time to the step that lands most, while it lands
-/// more; `source` is the raster `land` lands the source's cells from.
-DensePose climb(const PoseLander& land, const SliceGrid& source, double cell, DensePose p) {
+/// more; `source` is the raster `land` lands the source's cells from. The
+/// steps are scored alone and only where the climb stops is it landed.
+DensePose climb(const PoseLander& land, const SliceGrid& source, double cell, const DensePose& from) {
   const double yaw_step = 2.0 / std::hypot(source.width, source.height);
+  Rigid2D T = from.transform;
+  int offset = from.offset;
+  double score = from.score();
+  bool moved = false;
   for (int step = 0; step < kMaxSteps; ++step) {
-    const std::vector<DensePose> landed = land(stepsFrom(p, cell, yaw_step, source.centre()));
-    if (landed.empty()) break;
-    const DensePose next = best(landed);
-    if (next.score() <= p.score()) break;
-    p = next;
+    const PoseLander::Poses steps = stepsFrom(T, offset, cell, yaw_step, source.centre());
+    const std::vector<double> scores = land.scores(steps);
+    if (scores.empty()) break;
+    const size_t next = best(scores);
+    if (scores[next] <= score) break;
+    T = steps[next].first, offset = steps[next].second, score = scores[next], moved = true;
   }
-  return p;
+  return moved ? landPose(land, T, offset) : from;
 }
 
 }  // namespace
@@ -66,14 +72,16 @@ DensePose bestAround(const SliceStack& target, const SliceStack& source, const R
       shifted.t += target.grid.cell * Eigen::Vector2d(dx, dy);
       for (int o = offset - 1; o <= offset + 1; ++o) around.emplace_back(shifted, o);
     }
-  const std::vector<DensePose> landed = landPoses(target, source, around, params);
-  if (landed.empty()) return DensePose{T, offset, 0};
-  return best(landed);
+  const PoseLander land(target, source, params);
+  const std::vector<double> scores = land.scores(around);
+  if (scores.empty()) return DensePose{T, offset, 0};
+  const auto& [top, top_offset] = around[best(scores)];
+  return landPose(land, top, top_offset);
 }
 
 DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                  const DenseSearchParams& params) {
-  return uphill(poseLander(target, source, params), target, source, T, offset, params);
+  return uphill(PoseLander(target, source, params), target, source, T, offset, params);
 }
 
 DensePose uphill(const PoseLander& land, const SliceStack& target, const SliceStack& source, const Rigid2D& T,

@@ -192,3 +192,27 @@ TEST(DenseSearch, APoseOffTheRightOneClimbsUphillToIt) {
   EXPECT_LT(std::abs(top.transform.yaw), radians(1));
   EXPECT_GE(top.score(), landPose(room, room, Rigid2D{}, 0).score());
 }
+
+// A climb ranks its steps by score alone, counted on the telling cells alone,
+// and lands only where it stops: the scores are the landed poses' own, at
+// every height and at poses repeated in one call (one landing per transform).
+TEST(DenseSearch, ScoresAloneAreTheLandedPosesScores) {
+  const SliceStack room = stackOf(roomScan());
+  DenseSearchParams two_threads;
+  two_threads.threads = 2;
+  const PoseLander land(room, room, two_threads);
+  PoseLander::Poses poses;
+  for (const Rigid2D& T : {Rigid2D{}, Rigid2D{radians(4), {0.4, -0.3}}, Rigid2D{radians(180), {1.0, 0.5}}})
+    for (int offset : {-1, 0, 1, 0}) poses.emplace_back(T, offset);
+  const std::vector<DensePose> landed = land(poses);
+  const std::vector<double> scores = land.scores(poses);
+  ASSERT_EQ(landed.size(), poses.size());
+  ASSERT_EQ(scores.size(), poses.size());
+  for (size_t n = 0; n < poses.size(); ++n) {
+    SCOPED_TRACE(n);
+    EXPECT_EQ(landed[n].offset, poses[n].second);
+    EXPECT_EQ(landed[n].score(), landPose(room, room, poses[n].first, poses[n].second).score());
+    EXPECT_EQ(scores[n], landed[n].score());
+  }
+  EXPECT_GT(scores[1], scores[5]);  // the room on itself lands more than off it
+}
