@@ -3,18 +3,18 @@
 #include <cmath>
 
 namespace tomomap {
-namespace {
 
 /// A target slice's occupancy at one bit a cell. Every slice of the winning
 /// offset is held at once: as byte images, the street at g 0.1 (903 x 2453
 /// cells a slice, 76 slices) took 168 MB and most of the refinement's time
 /// to clear; as bits, 21 MB.
-class BitRaster {
+class OccupancyRefiner::Bits {
  public:
-  BitRaster(const SliceGrid& g, const std::vector<uint32_t>& cells)
+  Bits(const SliceGrid& g, const std::vector<uint32_t>& cells)
       : width_(static_cast<size_t>(g.width)),
         words_per_row_((width_ + 63) / 64),
-        words_(words_per_row_ * static_cast<size_t>(g.height), 0) {
+        words_(cells.empty() ? 0 : words_per_row_ * static_cast<size_t>(g.height),
+               0) {  // an empty slice pairs with none
     for (uint32_t c : cells) words_[c / width_ * words_per_row_ + c % width_ / 64] |= uint64_t{1} << (c % width_ % 64);
   }
   /// Calls f(u) for every occupied u in [u_lo, u_hi] of row v, in order: a
@@ -38,6 +38,8 @@ class BitRaster {
   std::vector<uint64_t> words_;
 };
 
+namespace {
+
 /// What the last search around one source cell found, and how far the cell
 /// may move before a new search could find anything else. Once ICP is near
 /// its answer the cells move by thousandths of a pixel an iteration, and the
@@ -51,7 +53,7 @@ struct Nearest {
 
 /// One slice pair: the target's occupancy and the source's cell centres.
 struct PairCells {
-  BitRaster target;
+  const OccupancyRefiner::Bits* target;
   std::vector<Eigen::Vector2d> source;  // source cell centres [m]
   std::vector<Nearest> nearest;         // one per source cell
   // This iteration's correspondences. Kept, with the joined list, so that
@@ -65,7 +67,8 @@ struct PairCells {
 /// may move before a new search could find another: another cell nearer,
 /// this one out of the window, or, where there is none, a cell within
 /// `radius`. Cells outside the window lie at least r + 0.5 pixels from f.
-Nearest searchWindow(const BitRaster& raster, const SliceGrid& g, const Eigen::Vector2d& f, double radius) {
+Nearest searchWindow(const OccupancyRefiner::Bits& raster, const SliceGrid& g, const Eigen::Vector2d& f,
+                     double radius) {
   const int r = static_cast<int>(std::ceil(radius));
   Nearest n;
   n.from = f;
@@ -98,7 +101,8 @@ Nearest searchWindow(const BitRaster& raster, const SliceGrid& g, const Eigen::V
   return n;
 }
 
-std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& source, int offset, size_t max_cells) {
+std::vector<PairCells> collectPairs(const SliceStack& target, const std::vector<OccupancyRefiner::Bits>& bits,
+                                    const SliceStack& source, int offset, size_t max_cells) {
   size_t total = 0;
   for (int i = 0; i < target.size(); ++i) {
     const int j = i - offset;
@@ -115,7 +119,7 @@ std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& 
     if (target.cells[static_cast<size_t>(i)].empty() || j < 0 || j >= source.size() ||
         source.cells[static_cast<size_t>(j)].empty())
       continue;
-    PairCells p{BitRaster(target.grid, target.cells[static_cast<size_t>(i)]), {}, {}, {}};
+    PairCells p{&bits[static_cast<size_t>(i)], {}, {}, {}};
     const auto& cells = source.cells[static_cast<size_t>(j)];
     for (size_t k = 0; k < cells.size(); k += stride) p.source.push_back(g.cellCentre(cells[k]));
     p.nearest.resize(p.source.size());
@@ -128,8 +132,22 @@ std::vector<PairCells> collectPairs(const SliceStack& target, const SliceStack& 
 
 DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& source, int offset,
                                     const Rigid2D& initial, const DenseRefineParams& params) {
+  return OccupancyRefiner(target, source)(offset, initial, params);
+}
+
+OccupancyRefiner::OccupancyRefiner(const SliceStack& target, const SliceStack& source)
+    : target_(target), source_(source), bits_([&] {
+        auto bits = std::make_shared<std::vector<Bits>>();
+        bits->reserve(target.cells.size());
+        for (const auto& cells : target.cells) bits->emplace_back(target.grid, cells);
+        return bits;
+      }()) {}
+
+DenseRefineResult OccupancyRefiner::operator()(int offset, const Rigid2D& initial,
+                                               const DenseRefineParams& params) const {
+  const SliceStack &target = target_, &source = source_;
   DenseRefineResult result{initial, 0};
-  std::vector<PairCells> pairs = collectPairs(target, source, offset, params.max_cells);
+  std::vector<PairCells> pairs = collectPairs(target, *bits_, source, offset, params.max_cells);
   if (pairs.empty()) return result;
   const auto& tg = target.grid;
   Correspondences c;  // every pair's, joined in pair order for the fit
@@ -157,12 +175,12 @@ DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& 
           Nearest& near = p.nearest[k];
           // The 1e-9 pixels keep rounding from deciding a reuse: a reused
           // search gives the very cell a new one would.
-          if (!((f - near.from).norm() + 1e-9 < near.slack)) near = searchWindow(p.target, tg, f, radius_cells);
+          if (!((f - near.from).norm() + 1e-9 < near.slack)) near = searchWindow(*p.target, tg, f, radius_cells);
           if (near.u < 0) continue;
           const double d2 = (near.u - f.x()) * (near.u - f.x()) + (near.v - f.y()) * (near.v - f.y());
           if (d2 > max_d2) continue;
           p.found.source.push_back(s);
-          p.found.target.push_back(tg.toMetres(static_cast<float>(near.u), static_cast<float>(near.v)).cast<double>());
+          p.found.target.push_back(tg.pixelCentre(near.u, near.v));
         }
       }
       c.source.clear();

@@ -1,5 +1,8 @@
 #pragma once
 // Dense refinement of the planar part of a match on the slices' occupied cells.
+#include <memory>
+#include <vector>
+
 #include "rigid2d.hpp"
 #include "slices.hpp"
 
@@ -24,5 +27,21 @@ struct DenseRefineResult {
 /// pixel quantisation out over thousands of cells.
 DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& source, int offset,
                                     const Rigid2D& initial, const DenseRefineParams& params = {});
+
+/// refineOnOccupancy with the target's occupancy prepared once for many
+/// refinements of poses on one pair of stacks (a dense search refines a dozen,
+/// a climb up to ten): preparing it was most of a refinement's own time. The
+/// stacks must outlive it.
+class OccupancyRefiner {
+ public:
+  OccupancyRefiner(const SliceStack& target, const SliceStack& source);
+  DenseRefineResult operator()(int offset, const Rigid2D& initial, const DenseRefineParams& params = {}) const;
+
+  class Bits;  ///< one target slice's occupancy at a bit a cell (dense_refine.cpp)
+
+ private:
+  const SliceStack &target_, &source_;
+  std::shared_ptr<const std::vector<Bits>> bits_;  ///< per target slice
+};
 
 }  // namespace tomomap

@@ -516,6 +516,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
 
   // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
   std::vector<DensePose> refined(coarse.size());
+  const OccupancyRefiner refine(target, source);
 #pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
   for (size_t n = 0; n < coarse.size(); ++n) {
     DensePose p = coarse[n];
@@ -527,7 +528,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
           best = t, p.offset = o;
     };
     bestOffsetNear(p.offset, c - 1);
-    p.transform = refineOnOccupancy(target, source, p.offset, p.transform).transform;  // one thread: this loop has them
+    p.transform = refine(p.offset, p.transform).transform;  // one thread: this loop has them
     bestOffsetNear(p.offset, 1);
     judge.judge(p, best);
     refined[n] = p;

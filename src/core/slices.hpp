@@ -22,10 +22,16 @@ struct SliceGrid {
   Eigen::Vector2f toMetres(float u, float v) const {
     return {static_cast<float>(x_min + (u + 0.5) * cell), static_cast<float>(y_min + (v + 0.5) * cell)};
   }
+  /// Map-frame x, y [m] of pixel (u, v)'s centre, in double throughout: taken
+  /// through float (toMetres) and back, GCC 12 at -O3 rounded it to float in
+  /// some inlined copies and kept it in double in others (vectorised), so the
+  /// same cell's centre moved by up to 1e-7 m from one build to the next and
+  /// a landing on a pixel's edge with it.
+  Eigen::Vector2d pixelCentre(int u, int v) const { return {x_min + (u + 0.5) * cell, y_min + (v + 0.5) * cell}; }
   /// Centre [m] of the cell stored as `index` (v * width + u) in SliceStack::cells.
   Eigen::Vector2d cellCentre(uint32_t index) const {
     const auto w = static_cast<uint32_t>(width);
-    return toMetres(static_cast<float>(index % w), static_cast<float>(index / w)).cast<double>();
+    return pixelCentre(static_cast<int>(index % w), static_cast<int>(index / w));
   }
   bool operator==(const SliceGrid& o) const {
     return cell == o.cell && x_min == o.x_min && y_min == o.y_min && z_min == o.z_min && width == o.width &&

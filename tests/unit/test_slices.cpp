@@ -125,3 +125,19 @@ TEST(Slices, PoolingKeepsEveryOccupiedCellAtTwiceTheCell) {
   // No cell is made up: a wall slice still holds the room's outline alone.
   EXPECT_EQ(p.cells[10].size(), 2u * static_cast<size_t>(p.grid.width + p.grid.height) - 4);
 }
+
+// A cell's centre is the same double in every build: through float and
+// back, GCC 12 at -O3 kept the rounding in one build and dropped it in the
+// next, and landings on a pixel's edge moved with it.
+TEST(Slices, ACellsCentreIsExactInDouble) {
+  SliceGrid g;
+  g.cell = 0.1, g.x_min = -4.0877, g.y_min = 10.3, g.width = 176, g.height = 174;
+  for (const uint32_t index : {0u, 175u, 176u, 12345u, 176u * 174u - 1u}) {
+    const int u = static_cast<int>(index % 176), v = static_cast<int>(index / 176);
+    const Eigen::Vector2d c = g.cellCentre(index);
+    EXPECT_EQ(c.x(), -4.0877 + (u + 0.5) * 0.1) << index;
+    EXPECT_EQ(c.y(), 10.3 + (v + 0.5) * 0.1) << index;
+    EXPECT_EQ(c, g.pixelCentre(u, v));
+    EXPECT_NEAR(g.toPixel(c.x(), c.y()).x(), u, 1e-9);
+  }
+}
