@@ -4,10 +4,10 @@
 
 namespace tomomap {
 
-/// A target slice's occupancy at one bit a cell. Every slice of the winning
-/// offset is held at once: as byte images, the street at g 0.1 (903 x 2453
-/// cells a slice, 76 slices) took 168 MB and most of the refinement's time
-/// to clear; as bits, 21 MB.
+/// A target slice's occupancy at one bit a cell. A refiner holds every
+/// slice at once: as byte images, the street at g 0.1 (903 x 2453 cells a
+/// slice, 76 slices) took 168 MB and most of the refinement's time to clear;
+/// as bits, 21 MB.
 class OccupancyRefiner::Bits {
  public:
   Bits(const SliceGrid& g, const std::vector<uint32_t>& cells)

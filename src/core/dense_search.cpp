@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <iterator>
 #include <limits>
 #include <map>
@@ -279,19 +280,41 @@ struct PoseJudge {
   }
 };
 
-/// `poses` by transform: the indices of the poses of each distinct one (a
-/// climb's steps and a ring of shifts land each transform at three heights,
-/// and where a transform lands the cells does not depend on the height).
+/// `poses` by transform: the indices of the poses of each distinct one, told
+/// apart by their bits (so that -0.0 and a NaN are transforms of their own).
 std::vector<std::vector<size_t>> byTransform(const PoseLander::Poses& poses) {
-  std::map<std::tuple<double, double, double>, size_t> index;
+  const auto bits = [](double x) {
+    uint64_t b;
+    std::memcpy(&b, &x, sizeof b);
+    return b;
+  };
+  std::map<std::tuple<uint64_t, uint64_t, uint64_t>, size_t> index;
   std::vector<std::vector<size_t>> out;
   for (size_t n = 0; n < poses.size(); ++n) {
     const Rigid2D& T = poses[n].first;
-    const auto [at, added] = index.try_emplace({T.yaw, T.t.x(), T.t.y()}, out.size());
+    const auto [at, added] = index.try_emplace({bits(T.yaw), bits(T.t.x()), bits(T.t.y())}, out.size());
     if (added) out.emplace_back();
     out[at->second].push_back(n);
   }
   return out;
+}
+
+/// Calls f(n, forth, back) for each of `poses` with where its transform lands
+/// `forth_cells` on the target and `back_cells` on the source: landed once
+/// per distinct transform (a climb's steps and a ring of shifts land each at
+/// several heights, and where a transform lands the cells does not depend on
+/// the height), the transforms spread over `threads`.
+template <typename F>
+void forEachLanding(const PoseJudge& judge, const PoseLander::Poses& poses, const std::vector<Cell>& forth_cells,
+                    const std::vector<Cell>& back_cells, int threads, const F& f) {
+  const std::vector<std::vector<size_t>> groups = byTransform(poses);
+#pragma omp parallel for schedule(dynamic) num_threads(threads)
+  for (size_t g = 0; g < groups.size(); ++g) {
+    const Rigid2D& T = poses[groups[g].front()].first;
+    const std::vector<int> forth = landings(forth_cells, T, judge.target.grid),
+                           back = landings(back_cells, T.inverse(), judge.source.grid);
+    for (size_t n : groups[g]) f(n, forth, back);
+  }
 }
 
 }  // namespace
@@ -316,33 +339,22 @@ PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const
   }
   const auto judge = std::make_shared<const PoseJudge>(target, source, params);
   const int threads = std::max(1, params.threads);
-  // Each distinct transform lands the cells once, both ways, for all its heights.
   land_ = [judge, threads](const Poses& poses) {
     std::vector<DensePose> out(poses.size());
-    const std::vector<std::vector<size_t>> groups = byTransform(poses);
-#pragma omp parallel for schedule(dynamic) num_threads(threads)
-    for (size_t g = 0; g < groups.size(); ++g) {
-      const Rigid2D& T = poses[groups[g].front()].first;
-      const std::vector<int> forth = landings(judge->source_cells, T, judge->target.grid),
-                             back = landings(judge->target_cells, T.inverse(), judge->source.grid);
-      for (size_t n : groups[g]) {
-        DensePose& p = out[n];
-        p.transform = T, p.offset = poses[n].second;
-        PoseJudge::judge(p, judge->forth(forth, p.offset), judge->backwards(back, p.offset));
-      }
-    }
+    forEachLanding(*judge, poses, judge->source_cells, judge->target_cells, threads,
+                   [&](size_t n, const std::vector<int>& forth, const std::vector<int>& back) {
+                     DensePose& p = out[n];
+                     p.transform = poses[n].first, p.offset = poses[n].second;
+                     PoseJudge::judge(p, judge->forth(forth, p.offset), judge->backwards(back, p.offset));
+                   });
     return out;
   };
   score_ = [judge, threads](const Poses& poses) {
     std::vector<double> out(poses.size());
-    const std::vector<std::vector<size_t>> groups = byTransform(poses);
-#pragma omp parallel for schedule(dynamic) num_threads(threads)
-    for (size_t g = 0; g < groups.size(); ++g) {
-      const Rigid2D& T = poses[groups[g].front()].first;
-      const std::vector<int> forth = landings(judge->source_telling, T, judge->target.grid),
-                             back = landings(judge->target_telling, T.inverse(), judge->source.grid);
-      for (size_t n : groups[g]) out[n] = judge->score(T, poses[n].second, forth, back);
-    }
+    forEachLanding(*judge, poses, judge->source_telling, judge->target_telling, threads,
+                   [&](size_t n, const std::vector<int>& forth, const std::vector<int>& back) {
+                     out[n] = judge->score(poses[n].first, poses[n].second, forth, back);
+                   });
     return out;
   };
 }

@@ -88,11 +88,11 @@ DensePose uphill(const PoseLander& land, const SliceStack& target, const SliceSt
                  int offset, const DenseSearchParams& params) {
   const double cell = target.grid.cell;
   DensePose top = climb(land, source.grid, cell, landPose(land, T, offset));
-  DenseRefineParams threads;
-  threads.threads = params.threads;
+  DenseRefineParams refine_params;
+  refine_params.threads = params.threads;
   const OccupancyRefiner refine(target, source);
   for (int round = 0; round < kMaxRefinements; ++round) {
-    const Rigid2D refined = refine(top.offset, top.transform, threads).transform;
+    const Rigid2D refined = refine(top.offset, top.transform, refine_params).transform;
     const DensePose next = climb(land, source.grid, cell, landPose(land, refined, top.offset));
     if (next.score() <= top.score()) break;
     top = next;

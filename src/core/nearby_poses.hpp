@@ -8,7 +8,7 @@ namespace tomomap {
 /// The best-scoring pose among `T` shifted by every whole grid cell more than
 /// `inner_cells` and at most `outer_cells` away, at T's yaw and within a slice
 /// of its height offset (a feature answer's height is a slice or two off,
-/// height_offsets.hpp), each judged as the dense search judges its poses (landPoses). A pose whose
+/// height_offsets.hpp), each judged as the dense search judges its poses (PoseLander). A pose whose
 /// neighbourhood holds one that lands as much lies on a ridge of the
 /// occupancy (a street's facades, two parallel walls) that the coarse raster
 /// of a dense search cannot resolve. Nothing landed (all counts 0) where
@@ -17,7 +17,7 @@ DensePose bestAround(const SliceStack& target, const SliceStack& source, const R
                      int outer_cells, const DenseSearchParams& params = {});
 
 /// The pose uphill of (T, offset): it climbs, one step at a time while a step
-/// lands more telling cells (landPoses): a grid cell in x or y, the yaw that
+/// lands more telling cells (PoseLander::scores): a grid cell in x or y, the yaw that
 /// moves the source raster's corner by a cell (turning about its centre), a
 /// slice in height. Where it stops, it is refined on the occupancy
 /// (refineOnOccupancy: nearest cells, not the count) and climbs again, while

@@ -23,10 +23,8 @@ struct SliceGrid {
     return {static_cast<float>(x_min + (u + 0.5) * cell), static_cast<float>(y_min + (v + 0.5) * cell)};
   }
   /// Map-frame x, y [m] of pixel (u, v)'s centre, in double throughout: taken
-  /// through float (toMetres) and back, GCC 12 at -O3 rounded it to float in
-  /// some inlined copies and kept it in double in others (vectorised), so the
-  /// same cell's centre moved by up to 1e-7 m from one build to the next and
-  /// a landing on a pixel's edge with it.
+  /// through float and back (toMetres), it came out of one build rounded and
+  /// of the next not (docs/results.md, "Cheaper candidates").
   Eigen::Vector2d pixelCentre(int u, int v) const { return {x_min + (u + 0.5) * cell, y_min + (v + 0.5) * cell}; }
   /// Centre [m] of the cell stored as `index` (v * width + u) in SliceStack::cells.
   Eigen::Vector2d cellCentre(uint32_t index) const {

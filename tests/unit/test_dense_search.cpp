@@ -211,26 +211,45 @@ TEST(DenseSearch, ScoresAloneAreTheLandedPosesScores) {
   ASSERT_EQ(scores.size(), poses.size());
   for (size_t n = 0; n < poses.size(); ++n) {
     SCOPED_TRACE(n);
+    // Landed with the others, each pose is landed as it is alone.
+    const DensePose alone = landPose(room, room, poses[n].first, poses[n].second);
+    EXPECT_EQ(landed[n].transform.yaw, poses[n].first.yaw);
+    EXPECT_EQ(landed[n].transform.t, poses[n].first.t);
     EXPECT_EQ(landed[n].offset, poses[n].second);
-    EXPECT_EQ(landed[n].score(), landPose(room, room, poses[n].first, poses[n].second).score());
+    EXPECT_EQ(landed[n].inliers, alone.inliers);
+    EXPECT_EQ(landed[n].telling_inliers, alone.telling_inliers);
+    EXPECT_EQ(landed[n].contradicted, alone.contradicted);
+    EXPECT_EQ(landed[n].support, alone.support);
+    EXPECT_EQ(landed[n].support_seen, alone.support_seen);
     EXPECT_EQ(scores[n], landed[n].score());
   }
   EXPECT_GT(scores[1], scores[5]);  // the room on itself lands more than off it
+  EXPECT_TRUE(land.scores({}).empty());
+  SliceStack partial = room;
+  partial.partial = true;  // some slices came over the network as features
+  EXPECT_TRUE(PoseLander(room, partial).scores(poses).empty());
+  const DensePose around = bestAround(room, partial, Rigid2D{}, 0, 5, 20);
+  EXPECT_EQ(around.offset, 0);
+  EXPECT_EQ(around.telling_inliers, 0u);
 }
 
-// The room on itself, started a few tenths of a cell and a few milliradians
-// off: ICP on the occupied cells brings it back within a tenth of a cell. One
-// refiner, its target prepared once, refines several starts at several
-// heights to the very transforms that a refinement each gives.
-TEST(DenseRefine, BringsARoomBackOntoItselfAndOnePreparationServesManyPoses) {
+// The room on itself, started a few hundredths of a metre and a few
+// milliradians off: ICP on the occupied cells brings it back within a tenth
+// of a cell.
+TEST(DenseRefine, BringsARoomBackOntoItself) {
   const SliceStack room = stackOf(roomScan());
-  const Rigid2D off{0.004, {0.03, -0.04}};
-  const Rigid2D back = refineOnOccupancy(room, room, 0, off).transform;
+  const Rigid2D back = refineOnOccupancy(room, room, 0, Rigid2D{0.004, {0.03, -0.04}}).transform;
   EXPECT_LT(back.t.norm(), 0.1 * kGrid);
   EXPECT_LT(std::abs(back.yaw), 0.001);
+}
 
+// One refiner, its target prepared once, refines several starts at several
+// heights to the very transforms that a refinement each gives: nothing of
+// one call stays for the next.
+TEST(DenseRefine, OnePreparationServesManyPosesAlike) {
+  const SliceStack room = stackOf(roomScan());
   const OccupancyRefiner refine(room, room);
-  for (const Rigid2D& start : {off, Rigid2D{-0.01, {0.1, 0.05}}, Rigid2D{}})
+  for (const Rigid2D& start : {Rigid2D{0.004, {0.03, -0.04}}, Rigid2D{-0.01, {0.1, 0.05}}, Rigid2D{}})
     for (int offset : {0, 1, -1}) {
       const Rigid2D once = refineOnOccupancy(room, room, offset, start).transform;
       const Rigid2D reused = refine(offset, start).transform;

@@ -126,9 +126,8 @@ TEST(Slices, PoolingKeepsEveryOccupiedCellAtTwiceTheCell) {
   EXPECT_EQ(p.cells[10].size(), 2u * static_cast<size_t>(p.grid.width + p.grid.height) - 4);
 }
 
-// A cell's centre is the same double in every build: through float and
-// back, GCC 12 at -O3 kept the rounding in one build and dropped it in the
-// next, and landings on a pixel's edge moved with it.
+// A cell's centre is the exact double of its pixel's, in every build
+// (through float and back it was not: docs/results.md, "Cheaper candidates").
 TEST(Slices, ACellsCentreIsExactInDouble) {
   SliceGrid g;
   g.cell = 0.1, g.x_min = -4.0877, g.y_min = 10.3, g.width = 176, g.height = 174;
