@@ -62,7 +62,9 @@ std::vector<Patch> flatPatches(const Points& map, size_t stride, const Eigen::Ma
     Sums& s = cubes[latticeKey(p, side)];
     const Eigen::Vector3d q = p.cast<double>();
     s.sum += q;
-    s.outer += q * q.transpose();
+    // The upper triangle alone: the lower one is the same products.
+    for (int r = 0; r < 3; ++r)
+      for (int c = r; c < 3; ++c) s.outer(r, c) += q(r) * q(c);
     ++s.n;
   }
   std::vector<Patch> patches;
@@ -70,7 +72,8 @@ std::vector<Patch> flatPatches(const Points& map, size_t stride, const Eigen::Ma
     if (s.n < kMinPatchPoints) continue;
     const double n = static_cast<double>(s.n);
     const Eigen::Vector3d mean = s.sum / n;
-    const Eigen::Matrix3d cov = s.outer / n - mean * mean.transpose();
+    const Eigen::Matrix3d outer = s.outer.selfadjointView<Eigen::Upper>();
+    const Eigen::Matrix3d cov = outer / n - mean * mean.transpose();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
     eig.computeDirect(cov);
     const Eigen::Vector3d l = eig.eigenvalues();  // ascending
