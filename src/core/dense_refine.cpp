@@ -10,11 +10,11 @@ namespace tomomap {
 /// as bits, 21 MB.
 class OccupancyRefiner::Bits {
  public:
+  /// An empty slice keeps no words: no source slice pairs with it.
   Bits(const SliceGrid& g, const std::vector<uint32_t>& cells)
       : width_(static_cast<size_t>(g.width)),
         words_per_row_((width_ + 63) / 64),
-        words_(cells.empty() ? 0 : words_per_row_ * static_cast<size_t>(g.height),
-               0) {  // an empty slice pairs with none
+        words_(cells.empty() ? 0 : words_per_row_ * static_cast<size_t>(g.height), 0) {
     for (uint32_t c : cells) words_[c / width_ * words_per_row_ + c % width_ / 64] |= uint64_t{1} << (c % width_ % 64);
   }
   /// Calls f(u) for every occupied u in [u_lo, u_hi] of row v, in order: a

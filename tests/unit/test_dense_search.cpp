@@ -194,6 +194,32 @@ TEST(DenseSearch, APoseOffTheRightOneClimbsUphillToIt) {
   EXPECT_GE(top.score(), landPose(room, room, Rigid2D{}, 0).score());
 }
 
+// A pose's landing slice by slice adds up to its tallies: on itself a room
+// lands every one of its cells and contradicts none; moved, its slices' cells
+// on the target add up to the pose's inliers.
+TEST(DenseSearch, APosesSlicesAddUpToItsTallies) {
+  const SliceStack room = stackOf(roomScan());
+  size_t cells = 0;
+  for (const auto& slice : room.cells) cells += slice.size();
+  const Rigid2D moved{radians(4), {0.4, -0.3}};
+  const auto slices = landSlices(room, room, {{Rigid2D{}, 0}, {moved, 1}});
+  ASSERT_EQ(slices.size(), 2u);
+  const auto sum = [](const std::vector<SliceLanding>& s, uint32_t SliceLanding::*count) {
+    size_t n = 0;
+    for (const SliceLanding& l : s) n += l.*count;
+    return n;
+  };
+  EXPECT_EQ(sum(slices[0], &SliceLanding::cells), cells);
+  EXPECT_EQ(sum(slices[0], &SliceLanding::on), cells);
+  EXPECT_EQ(sum(slices[0], &SliceLanding::seen), cells);
+  EXPECT_EQ(sum(slices[0], &SliceLanding::contradicted), 0u);
+  EXPECT_EQ(sum(slices[0], &SliceLanding::telling_on), sum(slices[0], &SliceLanding::telling));
+  EXPECT_EQ(sum(slices[1], &SliceLanding::cells), cells);
+  EXPECT_EQ(sum(slices[1], &SliceLanding::on), landPose(room, room, moved, 1).inliers);
+  EXPECT_LT(sum(slices[1], &SliceLanding::on), cells * 3 / 4) << "moved, fewer land";
+  for (size_t k = 0; k < slices[1].size(); ++k) EXPECT_EQ(slices[1][k].slice, static_cast<int>(k));
+}
+
 // A climb ranks its steps by score alone, counted on the telling cells alone,
 // and lands only where it stops: the scores are the landed poses' own, at
 // every height and at poses repeated in one call (one landing per transform).
