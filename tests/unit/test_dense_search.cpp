@@ -213,11 +213,23 @@ TEST(DenseSearch, APosesSlicesAddUpToItsTallies) {
   EXPECT_EQ(sum(slices[0], &SliceLanding::on), cells);
   EXPECT_EQ(sum(slices[0], &SliceLanding::seen), cells);
   EXPECT_EQ(sum(slices[0], &SliceLanding::contradicted), 0u);
+  EXPECT_GT(sum(slices[0], &SliceLanding::telling), 0u);
   EXPECT_EQ(sum(slices[0], &SliceLanding::telling_on), sum(slices[0], &SliceLanding::telling));
   EXPECT_EQ(sum(slices[1], &SliceLanding::cells), cells);
-  EXPECT_EQ(sum(slices[1], &SliceLanding::on), landPose(room, room, moved, 1).inliers);
+  const DensePose pose = landPose(room, room, moved, 1);
+  EXPECT_EQ(sum(slices[1], &SliceLanding::on), pose.inliers);
   EXPECT_LT(sum(slices[1], &SliceLanding::on), cells * 3 / 4) << "moved, fewer land";
-  for (size_t k = 0; k < slices[1].size(); ++k) EXPECT_EQ(slices[1][k].slice, static_cast<int>(k));
+  // Slice by slice: the slices holding half their cells, or half of those
+  // landing where the target saw anything, are the pose's support.
+  int holding = 0, holding_seen = 0;
+  for (const SliceLanding& l : slices[1]) {
+    holding += l.on > 0 && 2 * l.on >= l.cells;
+    holding_seen += l.seen > 0 && 2 * l.on >= l.seen;
+  }
+  EXPECT_EQ(holding, pose.support);
+  EXPECT_EQ(holding_seen, pose.support_seen);
+  EXPECT_GT(pose.support, 0);
+  EXPECT_LT(pose.support, room.size());
 }
 
 // A climb ranks its steps by score alone, counted on the telling cells alone,
