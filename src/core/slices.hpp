@@ -18,14 +18,13 @@ struct SliceGrid {
   double sliceHeight(int k) const { return z_min + k * cell; }
   /// Slice index of height z: slice k holds h_k - g/2 < z <= h_k + g/2.
   int sliceIndex(double z) const { return static_cast<int>(std::ceil((z - z_min) / cell - 0.5)); }
-  /// Map-frame x, y [m] of a (sub)pixel position; pixel centres are integers.
-  Eigen::Vector2f toMetres(float u, float v) const {
-    return {static_cast<float>(x_min + (u + 0.5) * cell), static_cast<float>(y_min + (v + 0.5) * cell)};
-  }
-  /// Map-frame x, y [m] of pixel (u, v)'s centre, in double throughout: taken
-  /// through float and back (toMetres), it came out of one build rounded and
-  /// of the next not (docs/results.md, "Cheaper candidates").
-  Eigen::Vector2d pixelCentre(int u, int v) const { return {x_min + (u + 0.5) * cell, y_min + (v + 0.5) * cell}; }
+  /// Map-frame x, y [m] of a (sub)pixel position (pixel centres are
+  /// integers), in double throughout: a cell's centre taken through float and
+  /// back (toMetres) came out of one build rounded and of the next not
+  /// (docs/results.md, "Cheaper candidates").
+  Eigen::Vector2d pixelCentre(double u, double v) const { return {x_min + (u + 0.5) * cell, y_min + (v + 0.5) * cell}; }
+  /// pixelCentre in float: a keypoint's position, as the features carry it.
+  Eigen::Vector2f toMetres(float u, float v) const { return pixelCentre(u, v).cast<float>(); }
   /// Centre [m] of the cell stored as `index` (v * width + u) in SliceStack::cells.
   Eigen::Vector2d cellCentre(uint32_t index) const {
     const auto w = static_cast<uint32_t>(width);
