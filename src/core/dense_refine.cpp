@@ -4,40 +4,6 @@
 
 namespace tomomap {
 
-/// A target slice's occupancy at one bit a cell. A refiner holds every
-/// slice at once: as byte images, the street at g 0.1 (903 x 2453 cells a
-/// slice, 76 slices) took 168 MB and most of the refinement's time to clear;
-/// as bits, 21 MB.
-class OccupancyRefiner::Bits {
- public:
-  /// An empty slice keeps no words: no source slice pairs with it.
-  Bits(const SliceGrid& g, const std::vector<uint32_t>& cells)
-      : width_(static_cast<size_t>(g.width)),
-        words_per_row_((width_ + 63) / 64),
-        words_(cells.empty() ? 0 : words_per_row_ * static_cast<size_t>(g.height), 0) {
-    for (uint32_t c : cells) words_[c / width_ * words_per_row_ + c % width_ / 64] |= uint64_t{1} << (c % width_ % 64);
-  }
-  /// Calls f(u) for every occupied u in [u_lo, u_hi] of row v, in order: a
-  /// word at a time, so the empty stretches that most of a search window is
-  /// cost one test each (demo-room's refinement: 0.038 -> 0.032 s, against
-  /// testing every cell of the window).
-  template <typename F>
-  void forEachOccupied(int v, int u_lo, int u_hi, F&& f) const {
-    const uint64_t* row = words_.data() + static_cast<size_t>(v) * words_per_row_;
-    const auto lo = static_cast<size_t>(u_lo), hi = static_cast<size_t>(u_hi);
-    for (size_t w = lo / 64; w <= hi / 64; ++w) {
-      uint64_t bits = row[w];
-      if (w == lo / 64) bits &= ~uint64_t{0} << (lo % 64);
-      if (w == hi / 64 && hi % 64 != 63) bits &= (uint64_t{1} << (hi % 64 + 1)) - 1;
-      for (; bits != 0; bits &= bits - 1) f(static_cast<int>(w * 64 + static_cast<size_t>(__builtin_ctzll(bits))));
-    }
-  }
-
- private:
-  size_t width_, words_per_row_;
-  std::vector<uint64_t> words_;
-};
-
 namespace {
 
 /// What the last search around one source cell found, and how far the cell
@@ -53,7 +19,7 @@ struct Nearest {
 
 /// One slice pair: the target's occupancy and the source's cell centres.
 struct PairCells {
-  const OccupancyRefiner::Bits* target;
+  const BitRaster* target;
   std::vector<Eigen::Vector2d> source;  // source cell centres [m]
   std::vector<Nearest> nearest;         // one per source cell
   // This iteration's correspondences. Kept, with the joined list, so that
@@ -67,8 +33,7 @@ struct PairCells {
 /// may move before a new search could find another: another cell nearer,
 /// this one out of the window, or, where there is none, a cell within
 /// `radius`. Cells outside the window lie at least r + 0.5 pixels from f.
-Nearest searchWindow(const OccupancyRefiner::Bits& raster, const SliceGrid& g, const Eigen::Vector2d& f,
-                     double radius) {
+Nearest searchWindow(const BitRaster& raster, const SliceGrid& g, const Eigen::Vector2d& f, double radius) {
   const int r = static_cast<int>(std::ceil(radius));
   Nearest n;
   n.from = f;
@@ -78,7 +43,7 @@ Nearest searchWindow(const OccupancyRefiner::Bits& raster, const SliceGrid& g, c
   const int u_lo = std::max(0, u0 - r), u_hi = std::min(g.width - 1, u0 + r);
   if (u_lo <= u_hi)
     for (int v = std::max(0, v0 - r); v <= std::min(g.height - 1, v0 + r); ++v)
-      raster.forEachOccupied(v, u_lo, u_hi, [&](int u) {
+      raster.forEachSet(v, u_lo, u_hi, [&](int u) {
         const double d2 = (u - f.x()) * (u - f.x()) + (v - f.y()) * (v - f.y());
         if (d2 <= best) {
           second = best;
@@ -101,7 +66,7 @@ Nearest searchWindow(const OccupancyRefiner::Bits& raster, const SliceGrid& g, c
   return n;
 }
 
-std::vector<PairCells> collectPairs(const SliceStack& target, const std::vector<OccupancyRefiner::Bits>& bits,
+std::vector<PairCells> collectPairs(const SliceStack& target, const std::vector<BitRaster>& bits,
                                     const SliceStack& source, int offset, size_t max_cells) {
   size_t total = 0;
   for (int i = 0; i < target.size(); ++i) {
@@ -137,7 +102,7 @@ DenseRefineResult refineOnOccupancy(const SliceStack& target, const SliceStack& 
 
 OccupancyRefiner::OccupancyRefiner(const SliceStack& target, const SliceStack& source)
     : target_(target), source_(source), bits_([&] {
-        auto bits = std::make_shared<std::vector<Bits>>();
+        auto bits = std::make_shared<std::vector<BitRaster>>();
         bits->reserve(target.cells.size());
         for (const auto& cells : target.cells) bits->emplace_back(target.grid, cells);
         return bits;

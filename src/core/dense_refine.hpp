@@ -3,6 +3,7 @@
 #include <memory>
 #include <vector>
 
+#include "bit_raster.hpp"
 #include "rigid2d.hpp"
 #include "slices.hpp"
 
@@ -37,11 +38,9 @@ class OccupancyRefiner {
   OccupancyRefiner(const SliceStack& target, const SliceStack& source);
   DenseRefineResult operator()(int offset, const Rigid2D& initial, const DenseRefineParams& params = {}) const;
 
-  class Bits;  ///< one target slice's occupancy at a bit a cell (dense_refine.cpp)
-
  private:
   const SliceStack &target_, &source_;
-  std::shared_ptr<const std::vector<Bits>> bits_;  ///< per target slice
+  std::shared_ptr<const std::vector<BitRaster>> bits_;  ///< per target slice
 };
 
 }  // namespace tomomap

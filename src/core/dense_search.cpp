@@ -11,6 +11,7 @@
 #include <optional>
 #include <tuple>
 
+#include "bit_raster.hpp"
 #include "dense_refine.hpp"
 #include "spectrum_correlation.hpp"
 
@@ -50,8 +51,10 @@ struct Cell {
 /// occupied (a floor or a ceiling).
 std::vector<Cell> cellsOf(const SliceStack& s, double wall_spread) {
   const int reach = static_cast<int>(std::floor(wall_spread / s.grid.cell + 1e-6));
-  const cv::Mat near = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * reach + 1, 2 * reach + 1));
-  cv::Mat column = cv::Mat::zeros(s.grid.height, s.grid.width, CV_16U), occupied;
+  const int w = s.grid.width, h = s.grid.height;
+  // Per pixel: in how many slices a cell lies within `reach` (a square), and
+  // the last slice that counted it, so that a slice counts a pixel once.
+  std::vector<int> column(static_cast<size_t>(w) * static_cast<size_t>(h), 0), counted(column.size(), -1);
   int occupied_slices = 0;
   size_t largest = 0;
   for (int k = 0; k < s.size(); ++k) {
@@ -59,15 +62,24 @@ std::vector<Cell> cellsOf(const SliceStack& s, double wall_spread) {
     if (cells.empty()) continue;
     ++occupied_slices;
     largest = std::max(largest, cells.size());
-    cv::dilate(s.image(k), occupied, near);
-    cv::add(column, occupied / 255, column, cv::noArray(), CV_16U);
+    for (uint32_t idx : cells) {
+      const int u = static_cast<int>(idx % static_cast<uint32_t>(w)),
+                v = static_cast<int>(idx / static_cast<uint32_t>(w));
+      for (int y = std::max(0, v - reach); y <= std::min(h - 1, v + reach); ++y)
+        for (int x = std::max(0, u - reach); x <= std::min(w - 1, u + reach); ++x) {
+          const size_t p = static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x);
+          if (counted[p] != k) counted[p] = k, ++column[p];
+        }
+    }
   }
   std::vector<Cell> out;
+  size_t count = 0;
+  for (const auto& cells : s.cells) count += cells.size();
+  out.reserve(count);
   for (int k = 0; k < s.size(); ++k) {
     const auto& cells = s.cells[static_cast<size_t>(k)];
     const bool flat = cells.size() * 2 > largest;
-    for (uint32_t idx : cells)  // the column image is continuous: cell index = element index
-      out.push_back({s.grid.cellCentre(idx), k, !flat && column.ptr<uint16_t>()[idx] * 2 < occupied_slices});
+    for (uint32_t idx : cells) out.push_back({s.grid.cellCentre(idx), k, !flat && column[idx] * 2 < occupied_slices});
   }
   return out;
 }
@@ -152,9 +164,9 @@ struct Tally {
   size_t contradicted = 0;  ///< telling cells off the target, in space it encloses (if given)
 };
 
-Tally countInliers(const std::vector<cv::Mat>& dilated, const std::vector<Cell>& cells, const std::vector<int>& landing,
-                   int offset, int source_slices, const Enclosure* enclosure = nullptr, const cv::Mat* seen = nullptr,
-                   std::vector<SliceLanding>* per_slice = nullptr) {
+Tally countInliers(const std::vector<BitRaster>& dilated, const std::vector<Cell>& cells,
+                   const std::vector<int>& landing, int offset, int source_slices, const Enclosure* enclosure = nullptr,
+                   const BitRaster* seen = nullptr, std::vector<SliceLanding>* per_slice = nullptr) {
   Tally t;
   std::vector<size_t> on(static_cast<size_t>(source_slices), 0), all(on), all_seen(on);
   if (per_slice) {
@@ -163,26 +175,26 @@ Tally countInliers(const std::vector<cv::Mat>& dilated, const std::vector<Cell>&
   }
   // Each source slice's target image at `offset` (null where there is none),
   // looked up once per call rather than once per cell.
-  std::vector<const uint8_t*> image(static_cast<size_t>(source_slices), nullptr);
+  std::vector<const BitRaster*> image(static_cast<size_t>(source_slices), nullptr);
   for (int k = 0; k < source_slices; ++k)
     if (const int i = k + offset;
         i >= 0 && i < static_cast<int>(dilated.size()) && !dilated[static_cast<size_t>(i)].empty())
-      image[static_cast<size_t>(k)] = dilated[static_cast<size_t>(i)].ptr<uint8_t>();
-  const uint8_t* seen_pixels = seen ? seen->ptr<uint8_t>() : nullptr;
+      image[static_cast<size_t>(k)] = &dilated[static_cast<size_t>(i)];
+  const BitRaster* seen_pixels = seen && !seen->empty() ? seen : nullptr;
   for (size_t n = 0; n < cells.size(); ++n) {
     const Cell& c = cells[n];
     SliceLanding* s = per_slice ? &(*per_slice)[static_cast<size_t>(c.slice)] : nullptr;
     if (s) ++s->cells, s->telling += c.telling;
-    const uint8_t* target = image[static_cast<size_t>(c.slice)];
+    const BitRaster* target = image[static_cast<size_t>(c.slice)];
     if (!target) continue;
     ++all[static_cast<size_t>(c.slice)];
-    // Dilated images are continuous: pixel index = element index.
     if (landing[n] < 0) continue;
-    if (seen_pixels && seen_pixels[landing[n]]) {
+    const auto at = static_cast<size_t>(landing[n]);
+    if (seen_pixels && seen_pixels->test(at)) {
       ++all_seen[static_cast<size_t>(c.slice)];
       if (s) ++s->seen;
     }
-    if (!target[landing[n]]) {
+    if (!target->test(at)) {
       const bool against = c.telling && enclosure && enclosure->encloses(landing[n], c.slice + offset);
       t.contradicted += against;
       if (s) s->contradicted += against;
@@ -200,23 +212,25 @@ Tally countInliers(const std::vector<cv::Mat>& dilated, const std::vector<Cell>&
   return t;
 }
 
-/// Every slice's occupancy grown by inlier_radius_cells: a cell lands on the
-/// stack where its pixel is set.
-std::vector<cv::Mat> dilatedSlices(const SliceStack& stack, const DenseSearchParams& params) {
+/// Every slice's occupancy grown by inlier_radius_cells (a disk, as OpenCV
+/// draws one): a cell lands on the stack where its pixel is set.
+std::vector<BitRaster> dilatedSlices(const SliceStack& stack, const DenseSearchParams& params) {
   const int r = static_cast<int>(std::floor(params.inlier_radius_cells));
   const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
-  std::vector<cv::Mat> images(static_cast<size_t>(stack.size()));
-  for (int k = 0; k < stack.size(); ++k)
-    if (!stack.cells[static_cast<size_t>(k)].empty()) cv::dilate(stack.image(k), images[static_cast<size_t>(k)], disk);
-  return images;
+  BitRaster::Stamp stamp;
+  for (int v = 0; v < disk.rows; ++v)
+    for (int u = 0; u < disk.cols; ++u)
+      if (disk.at<uint8_t>(v, u)) stamp.emplace_back(u - r, v - r);
+  std::vector<BitRaster> out;
+  out.reserve(static_cast<size_t>(stack.size()));
+  for (const std::vector<uint32_t>& cells : stack.cells) out.emplace_back(stack.grid, cells, stamp);
+  return out;
 }
 
-/// Where a map saw anything at any height: the union of its dilated slices
-/// (continuous, of the raster's size).
-cv::Mat footprint(const SliceStack& stack, const std::vector<cv::Mat>& dilated) {
-  cv::Mat out = cv::Mat::zeros(stack.grid.height, stack.grid.width, CV_8U);
-  for (const cv::Mat& m : dilated)
-    if (!m.empty()) cv::bitwise_or(out, m, out);
+/// Where a map saw anything at any height: the union of its dilated slices.
+BitRaster footprint(const std::vector<BitRaster>& dilated) {
+  BitRaster out;
+  for (const BitRaster& slice : dilated) out.add(slice);
   return out;
 }
 
@@ -230,11 +244,11 @@ std::vector<Cell> tellingOf(const std::vector<Cell>& cells) {
 /// occupancy, their cells and the space each saw empty.
 struct PoseJudge {
   const SliceStack &target, &source;
-  std::vector<cv::Mat> dilated, source_dilated;
+  std::vector<BitRaster> dilated, source_dilated;
   std::vector<Cell> source_cells, target_cells;
   std::vector<Cell> source_telling, target_telling;  ///< the telling ones alone: all a score counts
   Enclosure target_encloses, source_encloses;
-  cv::Mat target_seen;
+  BitRaster target_seen;
   const Enclosure *in_target, *in_source;  ///< null on cells too fine to read empty space
 
   PoseJudge(const SliceStack& t, const SliceStack& s, const DenseSearchParams& params)
@@ -248,7 +262,7 @@ struct PoseJudge {
         target_telling(tellingOf(target_cells)),
         target_encloses(t),
         source_encloses(s),
-        target_seen(footprint(t, dilated)),
+        target_seen(footprint(dilated)),
         in_target(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &target_encloses : nullptr),
         in_source(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &source_encloses : nullptr) {}
 
@@ -381,7 +395,7 @@ DensePose landPose(const SliceStack& target, const SliceStack& source, const Rig
 
 int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
                           const DenseSearchParams& params) {
-  const std::vector<cv::Mat> dilated = dilatedSlices(target, params);
+  const std::vector<BitRaster> dilated = dilatedSlices(target, params);
   const std::vector<Cell> cells = cellsOf(source, params.wall_spread);
   const std::vector<int> landing = landings(cells, T, target.grid);
   int best = middle;

@@ -1,0 +1,93 @@
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <set>
+
+#include "core/bit_raster.hpp"
+
+using namespace tomomap;
+
+namespace {
+
+/// A raster whose rows are not a whole number of words (rows share words).
+SliceGrid oddGrid() {
+  SliceGrid g;
+  g.cell = 0.1;
+  g.width = 131;
+  g.height = 37;
+  return g;
+}
+
+/// `n` distinct random cells of `g`, three of them on its border and corners.
+std::vector<uint32_t> randomCells(const SliceGrid& g, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<uint32_t> any(0, static_cast<uint32_t>(g.width * g.height - 1));
+  std::set<uint32_t> cells{0, static_cast<uint32_t>(g.width - 1), static_cast<uint32_t>(g.width * g.height - 1)};
+  while (static_cast<int>(cells.size()) < n) cells.insert(any(rng));
+  return {cells.begin(), cells.end()};
+}
+
+cv::Mat imageOf(const SliceGrid& g, const std::vector<uint32_t>& cells) {
+  cv::Mat img = cv::Mat::zeros(g.height, g.width, CV_8U);
+  for (uint32_t c : cells) img.at<uint8_t>(static_cast<int>(c) / g.width, static_cast<int>(c) % g.width) = 255;
+  return img;
+}
+
+}  // namespace
+
+TEST(BitRaster, AStampedRasterIsOpenCvsDilation) {
+  // The landings read a target cell's pixel in the bits where they read
+  // cv::dilate's image before: the two must set the very same pixels.
+  const SliceGrid g = oddGrid();
+  const std::vector<uint32_t> cells = randomCells(g, 150, 7);
+  for (int r : {1, 2}) {
+    const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
+    BitRaster::Stamp stamp;
+    for (int v = 0; v < disk.rows; ++v)
+      for (int u = 0; u < disk.cols; ++u)
+        if (disk.at<uint8_t>(v, u)) stamp.emplace_back(u - r, v - r);
+    const BitRaster bits(g, cells, stamp);
+    cv::Mat dilated;
+    cv::dilate(imageOf(g, cells), dilated, disk);
+    int set = 0;
+    for (int v = 0; v < g.height; ++v)
+      for (int u = 0; u < g.width; ++u) {
+        const bool expected = dilated.at<uint8_t>(v, u) != 0;
+        ASSERT_EQ(bits.test(static_cast<size_t>(v * g.width + u)), expected) << "r " << r << " at " << u << ", " << v;
+        set += expected;
+      }
+    EXPECT_GT(set, static_cast<int>(cells.size()));  // it grew
+  }
+}
+
+TEST(BitRaster, ARowsSetPixelsAreListedInOrderWithinTheRange) {
+  const SliceGrid g = oddGrid();
+  const std::vector<uint32_t> cells = randomCells(g, 900, 11);
+  const BitRaster bits(g, cells);
+  const std::set<uint32_t> occupied(cells.begin(), cells.end());
+  for (int v = 0; v < g.height; ++v)
+    for (const auto& [lo, hi] : {std::pair{0, g.width - 1}, std::pair{3, 70}, std::pair{63, 64}, std::pair{64, 127},
+                                 std::pair{128, 130}, std::pair{17, 17}}) {
+      std::vector<int> listed, expected;
+      bits.forEachSet(v, lo, hi, [&](int u) { listed.push_back(u); });
+      for (int u = lo; u <= hi; ++u)
+        if (occupied.count(static_cast<uint32_t>(v * g.width + u))) expected.push_back(u);
+      ASSERT_EQ(listed, expected) << "row " << v << " [" << lo << ", " << hi << "]";
+    }
+}
+
+TEST(BitRaster, NoCellsKeepNoWordsAndAddingIsTheUnion) {
+  const SliceGrid g = oddGrid();
+  EXPECT_TRUE(BitRaster(g, {}).empty());
+  const std::vector<uint32_t> a = randomCells(g, 40, 1), b = randomCells(g, 40, 2);
+  BitRaster both;
+  both.add(BitRaster(g, {}));
+  EXPECT_TRUE(both.empty());
+  both.add(BitRaster(g, a));
+  both.add(BitRaster(g, b));
+  std::set<uint32_t> either(a.begin(), a.end());
+  either.insert(b.begin(), b.end());
+  for (uint32_t p = 0; p < static_cast<uint32_t>(g.width * g.height); ++p)
+    ASSERT_EQ(both.test(p), either.count(p) == 1) << "pixel " << p;
+}
