@@ -55,7 +55,9 @@ std::pair<double, int> occupancyLead(const SliceScores& a, const SliceScores& b)
 }
 
 /// `a`'s lead over `b` in slice-pair estimates agreeing, over the source
-/// slices where either has one.
+/// slices where either has one, by signFlipLeadSigma: the counts are small
+/// and often the same from slice to slice, where a t reads any lead over
+/// two slices as certain.
 std::pair<double, int> votesLead(const Candidate& a, const Candidate& b) {
   std::vector<double> d;
   const size_t n = std::max(a.feature_votes.size(), b.feature_votes.size());
@@ -64,7 +66,7 @@ std::pair<double, int> votesLead(const Candidate& a, const Candidate& b) {
     const int vb = k < b.feature_votes.size() ? b.feature_votes[k] : 0;
     if (va > 0 || vb > 0) d.push_back(va - vb);
   }
-  return {pairedLeadSigma(d), static_cast<int>(d.size())};
+  return {signFlipLeadSigma(d), static_cast<int>(d.size())};
 }
 
 }  // namespace

@@ -36,6 +36,12 @@ double pairedLeadSigma(const std::vector<double>& differences) {
   return leadSigma(differences, static_cast<double>(differences.size()));
 }
 
+double signFlipLeadSigma(const std::vector<double>& differences) {
+  double sum = 0, squares = 0;
+  for (double x : differences) sum += x, squares += x * x;
+  return sum > 0 ? std::min(kMostSigma, sum / std::sqrt(squares)) : 0.0;
+}
+
 double sliceLeadSigma(const std::vector<double>& differences) {
   const size_t n = differences.size();
   if (n < 4) return pairedLeadSigma(differences);

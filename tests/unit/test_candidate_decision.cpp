@@ -65,6 +65,28 @@ TEST(CandidateDecision, SlicesThatEchoEachOtherCountForFewer) {
   EXPECT_GT(sliceLeadSigma(steady), 30.0);
 }
 
+// The features' votes are small counts, often the same from slice to slice:
+// a t over them reads one vote more on each of two slices as certain.
+TEST(CandidateDecision, AVotesLeadCountsByItsSlicesNotByHowAlikeTheyAre) {
+  EXPECT_GT(pairedLeadSigma({1, 1}), 30.0) << "what the t makes of it";
+  EXPECT_NEAR(signFlipLeadSigma({1, 1}), std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(signFlipLeadSigma(std::vector<double>(9, 2.0)), 3.0, 1e-12) << "9 slices alike: 3 sigma";
+  EXPECT_NEAR(signFlipLeadSigma({3, -1, 2, 0, 4}), 8.0 / std::sqrt(30.0), 1e-12);
+  EXPECT_EQ(signFlipLeadSigma({}), 0.0);
+  EXPECT_EQ(signFlipLeadSigma({-1, 1}), 0.0);
+  EXPECT_EQ(signFlipLeadSigma({1, -2}), 0.0);
+
+  // A LiDAR crop: the most voted-for pose has one estimate on each of two
+  // source slices, the pose elsewhere none, and the occupancy tells neither.
+  const MatchParams p = atTenCentimetres();
+  Candidate voted = landing(0, 0, 0, 2, {40}), other = landing(20, 0, 2.0, 2, {40});
+  voted.feature_votes = {1, 1};
+  other.feature_votes = {0, 0};
+  const CandidateVerdict v = decideOnCandidates({voted, other}, p, 0.1, Eigen::Vector2d::Zero());
+  EXPECT_EQ(v.answer, -1) << v.reason;
+  EXPECT_NE(v.reason.find("by 1.4 sigma over 2 source slices"), std::string::npos) << v.reason;
+}
+
 TEST(CandidateDecision, TheBestAnswersWhereItLeadsEveryPlaceElsewhereBeyondChance) {
   const MatchParams p = atTenCentimetres();
   std::vector<Candidate> c{landing(0, 0, 0, 20, {60, 70, 65}), landing(5, 0, 0, 20, {30, 20, 25}),
