@@ -1,11 +1,14 @@
 #pragma once
 // One slice's occupancy at a bit a pixel, indexed as SliceStack::cells are
 // (v * width + u): what the landings and the refinement on occupancy read.
-// A street at g 0.1 (1,085 x 1,210 cells a slice, 74 slices) is 97 MB a map
-// as byte images, 12 MB as bits; a dilation stamps its few occupied cells
-// instead of sweeping the raster. Landing the street's candidates on byte
-// images took 1.9 s of its 3.0 s match and 490 MB; on bits 0.65 s and 176 MB.
+// A large map's slices as byte images took most of a match's memory and,
+// cleared and dilated, most of its time, though a slice's occupied cells
+// are a percent of its raster or less; as bits they are an eighth, and a
+// dilation stamps the occupied cells instead of sweeping the raster
+// (docs/results.md, "Occupancy at a bit a pixel").
+#include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "slices.hpp"
@@ -14,8 +17,13 @@ namespace tomomap {
 
 class BitRaster {
  public:
-  /// A pixel's neighbours that a dilation sets: (du, dv) offsets.
+  /// A pixel's neighbours that a dilation sets: (du, dv) offsets. Stamped
+  /// around each occupied cell, a stamp symmetric about its centre (as a disk
+  /// or a square is) sets the pixels a dilation by it would.
   using Stamp = std::vector<std::pair<int, int>>;
+  /// The pixels within `radius_cells` as OpenCV draws a disk of the whole
+  /// cells in it (cv::MORPH_ELLIPSE): radius 1 is a cross of five.
+  static Stamp disk(double radius_cells);
 
   /// An empty raster keeps no words and reads nothing set.
   BitRaster() = default;

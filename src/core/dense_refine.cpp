@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "bit_raster.hpp"
+
 namespace tomomap {
 
 namespace {

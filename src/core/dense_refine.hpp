@@ -3,11 +3,12 @@
 #include <memory>
 #include <vector>
 
-#include "bit_raster.hpp"
 #include "rigid2d.hpp"
 #include "slices.hpp"
 
 namespace tomomap {
+
+class BitRaster;
 
 struct DenseRefineParams {
   std::vector<double> radii_cells{3.0, 1.5};  ///< correspondence radius per stage [grid cells]

@@ -7,7 +7,6 @@
 #include <limits>
 #include <map>
 #include <memory>
-#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <tuple>
 
@@ -53,8 +52,10 @@ std::vector<Cell> cellsOf(const SliceStack& s, double wall_spread) {
   const int reach = static_cast<int>(std::floor(wall_spread / s.grid.cell + 1e-6));
   const int w = s.grid.width, h = s.grid.height;
   // Per pixel: in how many slices a cell lies within `reach` (a square), and
-  // the last slice that counted it, so that a slice counts a pixel once.
-  std::vector<int> column(static_cast<size_t>(w) * static_cast<size_t>(h), 0), counted(column.size(), -1);
+  // the last slice that counted it, so that a slice counts a pixel once
+  // (slices are fewer than kMaxImageSide, so both fit 16 bits).
+  constexpr uint16_t kNone = UINT16_MAX;
+  std::vector<uint16_t> column(static_cast<size_t>(w) * static_cast<size_t>(h), 0), counted(column.size(), kNone);
   int occupied_slices = 0;
   size_t largest = 0;
   for (int k = 0; k < s.size(); ++k) {
@@ -68,7 +69,7 @@ std::vector<Cell> cellsOf(const SliceStack& s, double wall_spread) {
       for (int y = std::max(0, v - reach); y <= std::min(h - 1, v + reach); ++y)
         for (int x = std::max(0, u - reach); x <= std::min(w - 1, u + reach); ++x) {
           const size_t p = static_cast<size_t>(y) * static_cast<size_t>(w) + static_cast<size_t>(x);
-          if (counted[p] != k) counted[p] = k, ++column[p];
+          if (counted[p] != k) counted[p] = static_cast<uint16_t>(k), ++column[p];
         }
     }
   }
@@ -212,18 +213,13 @@ Tally countInliers(const std::vector<BitRaster>& dilated, const std::vector<Cell
   return t;
 }
 
-/// Every slice's occupancy grown by inlier_radius_cells (a disk, as OpenCV
-/// draws one): a cell lands on the stack where its pixel is set.
+/// Every slice's occupancy grown by inlier_radius_cells (BitRaster::disk): a
+/// cell lands on the stack where its pixel is set.
 std::vector<BitRaster> dilatedSlices(const SliceStack& stack, const DenseSearchParams& params) {
-  const int r = static_cast<int>(std::floor(params.inlier_radius_cells));
-  const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
-  BitRaster::Stamp stamp;
-  for (int v = 0; v < disk.rows; ++v)
-    for (int u = 0; u < disk.cols; ++u)
-      if (disk.at<uint8_t>(v, u)) stamp.emplace_back(u - r, v - r);
+  const BitRaster::Stamp disk = BitRaster::disk(params.inlier_radius_cells);
   std::vector<BitRaster> out;
   out.reserve(static_cast<size_t>(stack.size()));
-  for (const std::vector<uint32_t>& cells : stack.cells) out.emplace_back(stack.grid, cells, stamp);
+  for (const std::vector<uint32_t>& cells : stack.cells) out.emplace_back(stack.grid, cells, disk);
   return out;
 }
 

@@ -22,8 +22,8 @@ double sliceLeadSigma(const std::vector<double>& differences);
 
 /// How far the sum of `differences` (counts, one per slice) lies above zero
 /// against flipping their signs at random (no lead: each difference as
-/// likely either sign), as the normal deviate of that test: their sum over
-/// the root of their sum of squares. Unlike a t, it makes no more of a lead
+/// likely either sign), by that test's normal approximation: their sum over
+/// the root of their sum of squares (at most the root of their number). Unlike a t, it makes no more of a lead
 /// that is the same on every slice than of its slices' number: 2 slices a
 /// vote ahead each read 1.4, not beyond any bar. 0 where the sum is at or
 /// below zero.

@@ -39,22 +39,21 @@ cv::Mat imageOf(const SliceGrid& g, const std::vector<uint32_t>& cells) {
 TEST(BitRaster, AStampedRasterIsOpenCvsDilation) {
   // The landings read a target cell's pixel in the bits where they read
   // cv::dilate's image before: the two must set the very same pixels.
+  EXPECT_EQ(BitRaster::disk(1.5).size(), 5U) << "a cross";
   const SliceGrid g = oddGrid();
   const std::vector<uint32_t> cells = randomCells(g, 150, 7);
-  for (int r : {1, 2}) {
-    const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
-    BitRaster::Stamp stamp;
-    for (int v = 0; v < disk.rows; ++v)
-      for (int u = 0; u < disk.cols; ++u)
-        if (disk.at<uint8_t>(v, u)) stamp.emplace_back(u - r, v - r);
-    const BitRaster bits(g, cells, stamp);
+  for (double radius : {1.5, 2.5}) {  // the landings' 1.5 cells: a cross; 2.5: a disk wider than tall
+    const int r = static_cast<int>(radius);
+    const BitRaster bits(g, cells, BitRaster::disk(radius));
     cv::Mat dilated;
-    cv::dilate(imageOf(g, cells), dilated, disk);
+    cv::dilate(imageOf(g, cells), dilated,
+               cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
     int set = 0;
     for (int v = 0; v < g.height; ++v)
       for (int u = 0; u < g.width; ++u) {
         const bool expected = dilated.at<uint8_t>(v, u) != 0;
-        ASSERT_EQ(bits.test(static_cast<size_t>(v * g.width + u)), expected) << "r " << r << " at " << u << ", " << v;
+        ASSERT_EQ(bits.test(static_cast<size_t>(v * g.width + u)), expected)
+            << "radius " << radius << " at " << u << ", " << v;
         set += expected;
       }
     EXPECT_GT(set, static_cast<int>(cells.size()));  // it grew
