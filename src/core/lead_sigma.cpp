@@ -11,9 +11,9 @@ namespace {
 /// A lead whose chance probability is below double's range reads as this many sigmas.
 constexpr double kMostSigma = 37.0;
 
-/// pairedLeadSigma with the differences worth `independent` independent ones
-/// (at most their number): the standard error and the t's degrees of
-/// freedom follow from that many.
+/// The one-sided t test of the differences' mean, as a normal deviate, with
+/// the differences worth `independent` independent ones (at most their
+/// number): the standard error and the t's degrees of freedom follow from that many.
 double leadSigma(const std::vector<double>& differences, double independent) {
   const size_t n = differences.size();
   if (n < 2) return 0.0;
@@ -32,19 +32,15 @@ double leadSigma(const std::vector<double>& differences, double independent) {
 
 }  // namespace
 
-double pairedLeadSigma(const std::vector<double>& differences) {
-  return leadSigma(differences, static_cast<double>(differences.size()));
-}
-
 double signFlipLeadSigma(const std::vector<double>& differences) {
   double sum = 0, squares = 0;
   for (double x : differences) sum += x, squares += x * x;
-  return sum > 0 ? std::min(kMostSigma, sum / std::sqrt(squares)) : 0.0;
+  return differences.size() >= 2 && sum > 0 ? std::min(kMostSigma, sum / std::sqrt(squares)) : 0.0;
 }
 
 double sliceLeadSigma(const std::vector<double>& differences) {
   const size_t n = differences.size();
-  if (n < 4) return pairedLeadSigma(differences);
+  if (n < 4) return signFlipLeadSigma(differences);
   // Each slice's difference less the lead's straight-line course with
   // height: the lead may grow towards a furnished floor, which is a
   // difference in the mean, not slices echoing each other.

@@ -6,27 +6,27 @@
 
 namespace tomomap {
 
-/// How far the mean of `differences` (one per slice) lies above zero, by a
-/// one-sided Student t test over them, as the normal deviate of the same
-/// tail probability: a lead over 3 slices counts for less than the same
-/// t over 50. 0 for fewer than two differences or a mean at or below zero.
-double pairedLeadSigma(const std::vector<double>& differences);
-
-/// pairedLeadSigma for differences in slice order, lowest first, where
-/// neighbouring slices are not independent (they see the same walls): with
+/// How far the mean of `differences` (one per slice, in slice order, lowest
+/// first) lies above zero, by a one-sided Student t test over them, as the
+/// normal deviate of the same tail probability: a lead over 5 slices counts
+/// for less than the same t over 50. Neighbouring slices are not
+/// independent (they see the same walls): with
 /// their straight-line course with height taken out, the differences' lag-1
 /// autocorrelation rho (0 where negative) counts n slices as n (1 - rho) /
 /// (1 + rho) independent ones, at least 2 (the effective sample size of a
-/// first-order autoregressive series). Below 4 slices, pairedLeadSigma.
+/// first-order autoregressive series). Below 4 slices, signFlipLeadSigma:
+/// the spread of two or three differences may be near nothing, and a t then
+/// reads their lead as certain.
 double sliceLeadSigma(const std::vector<double>& differences);
 
-/// How far the sum of `differences` (counts, one per slice) lies above zero
-/// against flipping their signs at random (no lead: each difference as
-/// likely either sign), by that test's normal approximation: their sum over
-/// the root of their sum of squares (at most the root of their number). Unlike a t, it makes no more of a lead
-/// that is the same on every slice than of its slices' number: 2 slices a
-/// vote ahead each read 1.4, not beyond any bar. 0 where the sum is at or
-/// below zero.
+/// How far the sum of `differences` (one per slice or source slice) lies
+/// above zero against flipping their signs at random (no lead: each
+/// difference as likely either sign), by that test's normal approximation:
+/// their sum over the root of their sum of squares, at most the root of
+/// their number. Unlike a t, it makes no more of a lead that is the same on
+/// every slice than its slices' number allows: 2 slices a vote ahead each
+/// read 1.4, not beyond any bar. 0 for fewer than two differences or a sum
+/// at or below zero.
 double signFlipLeadSigma(const std::vector<double>& differences);
 
 }  // namespace tomomap

@@ -31,16 +31,16 @@ MatchParams atTenCentimetres() { return MatchParams{}; }
 }  // namespace
 
 TEST(CandidateDecision, ALeadCountsByItsSlicesSpreadAndNumber) {
-  EXPECT_EQ(pairedLeadSigma({}), 0.0);
-  EXPECT_EQ(pairedLeadSigma({5.0}), 0.0) << "one slice says nothing of chance";
-  EXPECT_EQ(pairedLeadSigma({-1, -2, -3}), 0.0);
-  EXPECT_GT(pairedLeadSigma({2, 2, 2, 2}), 30.0) << "the same lead on every slice";
-  // The same t (3.4-3.5) over 3 slices and over 50: the few count for less.
-  const double few = pairedLeadSigma({1.0, 2.0, 3.0});  // t = 2 / (1 / sqrt 3) = 3.46, 2 degrees of freedom
-  EXPECT_NEAR(few, 1.79, 0.02);                         // tail 3.7 %
-  std::vector<double> spread;
-  for (int k = 0; k < 50; ++k) spread.push_back(k % 2 ? 2.0 + 4.08 : 2.0 - 4.08);
-  EXPECT_NEAR(pairedLeadSigma(spread), 3.23, 0.02);  // t = 3.43, 49 degrees of freedom
+  EXPECT_EQ(sliceLeadSigma({}), 0.0);
+  EXPECT_EQ(sliceLeadSigma({5.0}), 0.0) << "one slice says nothing of chance";
+  EXPECT_EQ(sliceLeadSigma({-1, -2, -3, -4}), 0.0);
+  // The same t (3.43) over 4 slices and over 50, slices that do not echo
+  // each other (they alternate about the lead): the few count for less.
+  std::vector<double> few, many;
+  for (int k = 0; k < 4; ++k) few.push_back(k % 2 ? 2.0 + 1.00965 : 2.0 - 1.00965);
+  for (int k = 0; k < 50; ++k) many.push_back(k % 2 ? 2.0 + 4.08 : 2.0 - 4.08);
+  EXPECT_NEAR(sliceLeadSigma(few), 2.04, 0.02);   // 3 degrees of freedom: tail 2.1 %
+  EXPECT_NEAR(sliceLeadSigma(many), 3.23, 0.02);  // 49 degrees of freedom
 }
 
 // Neighbouring slices see the same walls: a lead that rises and falls
@@ -49,26 +49,24 @@ TEST(CandidateDecision, SlicesThatEchoEachOtherCountForFewer) {
   std::vector<double> wave, shuffled;
   for (int k = 0; k < 30; ++k) wave.push_back(1.0 + 2.0 * std::sin(k / 4.0));
   for (int k = 0; k < 30; ++k) shuffled.push_back(wave[static_cast<size_t>(k % 2 ? k / 2 : 29 - k / 2)]);
-  EXPECT_NEAR(pairedLeadSigma(wave), pairedLeadSigma(shuffled), 1e-9) << "the paired test does not see the order";
-  EXPECT_GE(pairedLeadSigma(wave), 3.0);
+  EXPECT_GE(sliceLeadSigma(shuffled), 3.0) << "the same differences in no order: 30 looks";
   EXPECT_NEAR(sliceLeadSigma(wave), 0.76, 0.02) << "a slow wave is a few looks, not 30: 2 at the least";
   EXPECT_GT(sliceLeadSigma(shuffled), sliceLeadSigma(wave));
   // A lead that grows steadily with height is a difference in the mean, not
   // an echo: the straight line is taken out before the slices are compared.
   std::vector<double> ramp;
   for (int k = 0; k < 30; ++k) ramp.push_back(1.0 + 0.1 * k + (k % 2 ? 0.5 : -0.5));
-  EXPECT_DOUBLE_EQ(sliceLeadSigma(ramp), pairedLeadSigma(ramp));
-  EXPECT_DOUBLE_EQ(sliceLeadSigma({1.0, 2.0, 3.0}), pairedLeadSigma({1.0, 2.0, 3.0})) << "too few to tell";
+  EXPECT_NEAR(sliceLeadSigma(ramp), 7.38, 0.02);  // the plain t over 30 slices: t = 12.9
+  EXPECT_DOUBLE_EQ(sliceLeadSigma({1.0, 2.0, 3.0}), signFlipLeadSigma({1.0, 2.0, 3.0})) << "too few to tell";
+  EXPECT_LT(sliceLeadSigma({0.2, 0.2001, 0.2}), 2.0) << "three slices alike are three slices, not a certainty";
   EXPECT_EQ(sliceLeadSigma({}), 0.0);
   const std::vector<double> steady(30, 0.1);  // the same lead on every slice, to rounding
-  EXPECT_DOUBLE_EQ(sliceLeadSigma(steady), pairedLeadSigma(steady));
   EXPECT_GT(sliceLeadSigma(steady), 30.0);
 }
 
 // The features' votes are small counts, often the same from slice to slice:
 // a t over them reads one vote more on each of two slices as certain.
 TEST(CandidateDecision, AVotesLeadCountsByItsSlicesNotByHowAlikeTheyAre) {
-  EXPECT_GT(pairedLeadSigma({1, 1}), 30.0) << "what the t makes of it";
   EXPECT_NEAR(signFlipLeadSigma({1, 1}), std::sqrt(2.0), 1e-12);
   EXPECT_NEAR(signFlipLeadSigma(std::vector<double>(9, 2.0)), 3.0, 1e-12) << "9 slices alike: 3 sigma";
   EXPECT_NEAR(signFlipLeadSigma({3, -1, 2, 0, 4}), 8.0 / std::sqrt(30.0), 1e-12);
