@@ -57,11 +57,12 @@ std::vector<Cell> cellsOf(const SliceStack& s, double wall_spread) {
   constexpr uint16_t kNone = UINT16_MAX;
   std::vector<uint16_t> column(static_cast<size_t>(w) * static_cast<size_t>(h), 0), counted(column.size(), kNone);
   int occupied_slices = 0;
-  size_t largest = 0;
+  size_t largest = 0, count = 0;
   for (int k = 0; k < s.size(); ++k) {
     const auto& cells = s.cells[static_cast<size_t>(k)];
     if (cells.empty()) continue;
     ++occupied_slices;
+    count += cells.size();
     largest = std::max(largest, cells.size());
     for (uint32_t idx : cells) {
       const int u = static_cast<int>(idx % static_cast<uint32_t>(w)),
@@ -74,8 +75,6 @@ std::vector<Cell> cellsOf(const SliceStack& s, double wall_spread) {
     }
   }
   std::vector<Cell> out;
-  size_t count = 0;
-  for (const auto& cells : s.cells) count += cells.size();
   out.reserve(count);
   for (int k = 0; k < s.size(); ++k) {
     const auto& cells = s.cells[static_cast<size_t>(k)];

@@ -28,12 +28,6 @@ std::vector<uint32_t> randomCells(const SliceGrid& g, int n, unsigned seed) {
   return {cells.begin(), cells.end()};
 }
 
-cv::Mat imageOf(const SliceGrid& g, const std::vector<uint32_t>& cells) {
-  cv::Mat img = cv::Mat::zeros(g.height, g.width, CV_8U);
-  for (uint32_t c : cells) img.at<uint8_t>(static_cast<int>(c) / g.width, static_cast<int>(c) % g.width) = 255;
-  return img;
-}
-
 }  // namespace
 
 TEST(BitRaster, AStampedRasterIsOpenCvsDilation) {
@@ -46,7 +40,7 @@ TEST(BitRaster, AStampedRasterIsOpenCvsDilation) {
     const int r = static_cast<int>(radius);
     const BitRaster bits(g, cells, BitRaster::disk(radius));
     cv::Mat dilated;
-    cv::dilate(imageOf(g, cells), dilated,
+    cv::dilate(SliceStack{g, {cells}}.image(0), dilated,
                cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
     int set = 0;
     for (int v = 0; v < g.height; ++v)
