@@ -538,6 +538,8 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
   std::vector<DensePose> refined(coarse.size());
   const OccupancyRefiner refine(target, source);
+  DenseRefineParams refine_params;  // one thread: the loop over the poses has them
+  refine_params.max_cells = params.refine_cells;
 #pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
   for (size_t n = 0; n < coarse.size(); ++n) {
     DensePose p = coarse[n];
@@ -549,7 +551,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
           best = t, p.offset = o;
     };
     bestOffsetNear(p.offset, c - 1);
-    p.transform = refine(p.offset, p.transform).transform;  // one thread: this loop has them
+    p.transform = refine(p.offset, p.transform, refine_params).transform;
     bestOffsetNear(p.offset, 1);
     judge.judge(p, best);
     refined[n] = p;

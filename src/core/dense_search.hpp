@@ -18,6 +18,13 @@ struct DenseSearchParams {
   int min_coarsening = 1;            ///< the coarse cell is at least this many grid cells (kWideCoarseSide)
   double yaw_step = radians(3.0);    ///< [rad]; 3 deg moves a point 3 m out by 0.16 m, under one coarse cell
   int candidates = 12;               ///< distinct coarse poses refined on the full grid
+  /// Source cells each coarse pose's refinement uses at most (evenly
+  /// thinned): that refinement only ranks the search's poses, and the pose
+  /// that is judged is refined again on all of them where it is climbed
+  /// (nearby_poses.hpp). A quarter of DenseRefineParams::max_cells moved no
+  /// outcome of the matrix and took a sixth off its CPU (docs/results.md,
+  /// "A search's poses refined on fewer cells").
+  size_t refine_cells = 10000;
   double inlier_radius_cells = 1.5;  ///< [grid cells]
   /// How far a scanned wall wanders from slice to slice (range noise either
   /// side) [m]: a wall's column is counted with its neighbours this far.
