@@ -212,6 +212,29 @@ Tally countInliers(const std::vector<BitRaster>& dilated, const std::vector<Cell
   return t;
 }
 
+/// The height offset from `lowest` to `lowest + count - 1` at which most of
+/// the source `cells`, landed at `landing`, fall on a dilated target cell
+/// (countInliers' inliers; the first of the most, or `preferred` among them),
+/// counted for every offset in one pass over the cells: choosing a height
+/// needs the inliers alone, not the rest of a tally.
+int mostInliersAt(const std::vector<BitRaster>& dilated, const std::vector<Cell>& cells,
+                  const std::vector<int>& landing, int lowest, int count, std::optional<int> preferred = {}) {
+  std::vector<size_t> inliers(static_cast<size_t>(count), 0);
+  const int slices = static_cast<int>(dilated.size());
+  for (size_t n = 0; n < cells.size(); ++n) {
+    if (landing[n] < 0) continue;
+    const auto at = static_cast<size_t>(landing[n]);
+    const int first = std::max(0, cells[n].slice + lowest), last = std::min(slices - 1, cells[n].slice + lowest + count - 1);
+    for (int i = first; i <= last; ++i)
+      if (const BitRaster& target = dilated[static_cast<size_t>(i)]; !target.empty() && target.test(at))
+        ++inliers[static_cast<size_t>(i - cells[n].slice - lowest)];
+  }
+  size_t best = preferred ? static_cast<size_t>(*preferred - lowest) : 0;
+  for (size_t k = 0; k < inliers.size(); ++k)
+    if (inliers[k] > inliers[best]) best = k;
+  return lowest + static_cast<int>(best);
+}
+
 /// Every slice's occupancy grown by inlier_radius_cells (BitRaster::disk): a
 /// cell lands on the stack where its pixel is set.
 std::vector<BitRaster> dilatedSlices(const SliceStack& stack, const DenseSearchParams& params) {
@@ -390,14 +413,9 @@ DensePose landPose(const SliceStack& target, const SliceStack& source, const Rig
 
 int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
                           const DenseSearchParams& params) {
-  const std::vector<BitRaster> dilated = dilatedSlices(target, params);
   const std::vector<Cell> cells = cellsOf(source, params.wall_spread);
-  const std::vector<int> landing = landings(cells, T, target.grid);
-  int best = middle;
-  size_t most = countInliers(dilated, cells, landing, middle, source.size()).inliers;
-  for (int o = middle - reach; o <= middle + reach; ++o)
-    if (const size_t n = countInliers(dilated, cells, landing, o, source.size()).inliers; n > most) best = o, most = n;
-  return best;
+  return mostInliersAt(dilatedSlices(target, params), cells, landings(cells, T, target.grid), middle - reach,
+                       2 * reach + 1, middle);
 }
 
 bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params) {
@@ -543,17 +561,15 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
 #pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
   for (size_t n = 0; n < coarse.size(); ++n) {
     DensePose p = coarse[n];
-    Tally best;
+    std::vector<int> landing;
     const auto bestOffsetNear = [&](int middle, int reach) {
-      const std::vector<int> landing = landings(source_cells, p.transform, tg);
-      for (int o = middle - reach; o <= middle + reach; ++o)
-        if (const Tally t = judge.forth(landing, o); o == middle - reach || t.inliers > best.inliers)
-          best = t, p.offset = o;
+      landing = landings(source_cells, p.transform, tg);
+      p.offset = mostInliersAt(judge.dilated, source_cells, landing, middle - reach, 2 * reach + 1);
     };
     bestOffsetNear(p.offset, c - 1);
     p.transform = refine(p.offset, p.transform, refine_params).transform;
     bestOffsetNear(p.offset, 1);
-    judge.judge(p, best);
+    judge.judge(p, judge.forth(landing, p.offset));
     refined[n] = p;
   }
   std::stable_sort(refined.begin(), refined.end(),
