@@ -224,7 +224,8 @@ int mostInliersAt(const std::vector<BitRaster>& dilated, const std::vector<Cell>
   for (size_t n = 0; n < cells.size(); ++n) {
     if (landing[n] < 0) continue;
     const auto at = static_cast<size_t>(landing[n]);
-    const int first = std::max(0, cells[n].slice + lowest), last = std::min(slices - 1, cells[n].slice + lowest + count - 1);
+    const int first = std::max(0, cells[n].slice + lowest),
+              last = std::min(slices - 1, cells[n].slice + lowest + count - 1);
     for (int i = first; i <= last; ++i)
       if (const BitRaster& target = dilated[static_cast<size_t>(i)]; !target.empty() && target.test(at))
         ++inliers[static_cast<size_t>(i - cells[n].slice - lowest)];

@@ -15,15 +15,16 @@ struct DenseSearchParams {
   /// The coarse raster has at most this many cells along each axis; the
   /// coarse cell is a whole number of grid cells (at most kMaxCoarsening).
   int coarse_side = 32;
-  int min_coarsening = 1;            ///< the coarse cell is at least this many grid cells (kWideCoarseSide)
-  double yaw_step = radians(3.0);    ///< [rad]; 3 deg moves a point 3 m out by 0.16 m, under one coarse cell
-  int candidates = 12;               ///< distinct coarse poses refined on the full grid
+  int min_coarsening = 1;          ///< the coarse cell is at least this many grid cells (kWideCoarseSide)
+  double yaw_step = radians(3.0);  ///< [rad]; 3 deg moves a point 3 m out by 0.16 m, under one coarse cell
+  int candidates = 12;             ///< distinct coarse poses refined on the full grid
   /// Source cells each coarse pose's refinement uses at most (evenly
-  /// thinned): that refinement only ranks the search's poses, and the pose
-  /// that is judged is refined again on all of them where it is climbed
-  /// (nearby_poses.hpp). A quarter of DenseRefineParams::max_cells moved no
-  /// outcome of the matrix and took a sixth off its CPU (docs/results.md,
-  /// "A search's poses refined on fewer cells").
+  /// thinned): that refinement ranks the search's poses, and a pose that
+  /// answers or is among the best candidates is refined again on all of
+  /// them where it is climbed (nearby_poses.hpp). A quarter of
+  /// DenseRefineParams::max_cells moved no outcome of four suites and took a
+  /// sixth off the matrix's CPU (docs/results.md, "A search's poses refined
+  /// on fewer cells").
   size_t refine_cells = 10000;
   double inlier_radius_cells = 1.5;  ///< [grid cells]
   /// How far a scanned wall wanders from slice to slice (range noise either
