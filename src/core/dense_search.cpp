@@ -212,11 +212,12 @@ Tally countInliers(const std::vector<BitRaster>& dilated, const std::vector<Cell
   return t;
 }
 
-/// The height offset from `lowest` to `lowest + count - 1` at which most of
-/// the source `cells`, landed at `landing`, fall on a dilated target cell
-/// (countInliers' inliers; the first of the most, or `preferred` among them),
-/// counted for every offset in one pass over the cells: choosing a height
-/// needs the inliers alone, not the rest of a tally.
+/// The height offset from `lowest` to `lowest + count - 1` (count >= 1) at
+/// which most of the source `cells`, landed at `landing`, fall on a dilated
+/// target cell (countInliers' inliers; the first of the most, or `preferred`,
+/// an offset in that range, where it is among them), counted for every offset
+/// in one pass over the cells: choosing a height needs the inliers alone, not
+/// the rest of a tally.
 int mostInliersAt(const std::vector<BitRaster>& dilated, const std::vector<Cell>& cells,
                   const std::vector<int>& landing, int lowest, int count, std::optional<int> preferred = {}) {
   std::vector<size_t> inliers(static_cast<size_t>(count), 0);
@@ -557,8 +558,9 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
   // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
   std::vector<DensePose> refined(coarse.size());
   const OccupancyRefiner refine(target, source);
-  DenseRefineParams refine_params;  // one thread: the loop over the poses has them
+  DenseRefineParams refine_params;
   refine_params.max_cells = params.refine_cells;
+  refine_params.threads = 1;  // the loop over the poses has them
 #pragma omp parallel for schedule(dynamic) num_threads(std::max(1, params.threads))
   for (size_t n = 0; n < coarse.size(); ++n) {
     DensePose p = coarse[n];

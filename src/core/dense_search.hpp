@@ -18,13 +18,11 @@ struct DenseSearchParams {
   int min_coarsening = 1;          ///< the coarse cell is at least this many grid cells (kWideCoarseSide)
   double yaw_step = radians(3.0);  ///< [rad]; 3 deg moves a point 3 m out by 0.16 m, under one coarse cell
   int candidates = 12;             ///< distinct coarse poses refined on the full grid
-  /// Source cells each coarse pose's refinement uses at most (evenly
-  /// thinned): that refinement ranks the search's poses, and a pose that
-  /// answers or is among the best candidates is refined again on all of
-  /// them where it is climbed (nearby_poses.hpp). A quarter of
-  /// DenseRefineParams::max_cells moved no outcome of four suites and took a
-  /// sixth off the matrix's CPU (docs/results.md, "A search's poses refined
-  /// on fewer cells").
+  /// Source cells each coarse pose's ICP uses at most (evenly thinned):
+  /// that refinement ranks the search's poses, and a pose that answers, or a
+  /// candidate that climbs, is refined again on up to
+  /// DenseRefineParams::max_cells (nearby_poses.hpp). What a quarter of those
+  /// cells changed: docs/results.md, "A search's poses refined on fewer cells".
   size_t refine_cells = 10000;
   double inlier_radius_cells = 1.5;  ///< [grid cells]
   /// How far a scanned wall wanders from slice to slice (range noise either
@@ -88,7 +86,8 @@ bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params = 
 /// The height offset (target slice index - source slice index) within `reach`
 /// slices of `middle` at which `T` lands the most source cells within
 /// inlier_radius_cells of a target cell; `middle` where none lands more. The
-/// dense search places each of its poses so.
+/// dense search places each of its poses by the same count (the first of the
+/// most within one coarse cell of height).
 int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
                           const DenseSearchParams& params = {});
 

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "core/dense_refine.hpp"
 #include "core/dense_search.hpp"
 #include "core/nearby_poses.hpp"
@@ -269,6 +271,24 @@ TEST(DenseSearch, ScoresAloneAreTheLandedPosesScores) {
   const DensePose around = bestAround(room, partial, Rigid2D{}, 0, 5, 20);
   EXPECT_EQ(around.offset, 0);
   EXPECT_EQ(around.telling_inliers, 0u);
+}
+
+// The height the occupancy gives a pose: where most of the source's cells
+// land, the offset asked about where it is among the most, else the first
+// of them; offsets with no target slice there land nothing.
+TEST(DenseSearch, TheOccupancysHeightIsWhereMostCellsLandTheOneAskedAboutOnATie) {
+  const SliceStack room = stackOf(roomScan());
+  const auto fullest = std::max_element(room.cells.begin(), room.cells.end(),
+                                        [](const auto& a, const auto& b) { return a.size() < b.size(); });
+  SliceStack one = room, five = room, gaps = room;
+  one.cells = {*fullest};
+  five.cells.assign(5, *fullest);                 // the same slice at heights 0-4: every offset 0-4 lands alike
+  gaps.cells = {{}, *fullest, *fullest, {}, {}};  // only offsets 1 and 2 land anything
+  EXPECT_EQ(occupancyHeightOffset(five, one, Rigid2D{}, 2, 2), 2);
+  EXPECT_EQ(occupancyHeightOffset(five, one, Rigid2D{}, 1, 3), 1);
+  EXPECT_EQ(occupancyHeightOffset(five, one, Rigid2D{}, -3, 1), -3);  // nothing lands: the offset asked about
+  EXPECT_EQ(occupancyHeightOffset(gaps, one, Rigid2D{}, 3, 3), 1);
+  EXPECT_EQ(occupancyHeightOffset(gaps, one, Rigid2D{}, 2, 1), 2);
 }
 
 // The room on itself, started a few hundredths of a metre and a few
