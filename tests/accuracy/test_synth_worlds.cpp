@@ -260,12 +260,14 @@ TEST(SmallRooms, APooledSearchDoesNotConfirmAFeatureAnswer) {
 
 // A small map's answer takes the height offset where most of the source's
 // occupancy lands on the target's: the features' offset is the centre of a
-// smear of offsets. Seed 111 at high noise, g 0.05, is a feature answer the
-// dense search confirms; at the features' offset it was 0.219 m off (0.207 m
-// of it in height) against a 0.25 m limit.
+// smear of offsets. Seed 159 at high noise, g 0.05, is a feature answer the
+// dense search confirms; at the features' offset, two slices low, it would be
+// 0.150 m off (0.140 m of it in height), at the occupancy's 0.067 m. (Seed
+// 111, which showed it first, is answered by the pooled search since a
+// search's poses are refined on fewer cells, as right.)
 TEST(SmallRooms, AnAnswerTakesTheHeightWhereTheOccupancyMeetsBest) {
-  const RoomMatch m = matchRoom(111, "high", 0.05);
-  expectAnsweredRightBy(m, 0.05, By::features, "seed 111");
+  const RoomMatch m = matchRoom(159, "high", 0.05);
+  expectAnsweredRightBy(m, 0.05, By::features, "seed 159");
   EXPECT_LT(m.error.translation, 0.1) << "yaw error " << m.error.yaw;
 }
 
