@@ -16,16 +16,17 @@ constexpr size_t kMostClimbs = 4;
 /// A height offset in slices as an offset in slices pooled by two.
 int pooledOffset(int offset) { return static_cast<int>(std::floor(offset / 2.0 + 0.5)); }
 
-/// `out` with each candidate's landing, slice by slice (and on pooled
-/// occupancy for fine maps), its feature votes and its whole transform.
-std::vector<Candidate> finished(std::vector<Candidate> out, const MapFeatures& target, const MapFeatures& source,
-                                const DenseSearchParams& dp, const FeatureVotes& votes) {
+/// `out` with each candidate's landing, slice by slice (by `land`, the
+/// maps' occupancy's lander, and on pooled occupancy for fine maps), its
+/// feature votes and its whole transform.
+std::vector<Candidate> finished(std::vector<Candidate> out, const PoseLander& land, const MapFeatures& target,
+                                const MapFeatures& source, const DenseSearchParams& dp, const FeatureVotes& votes) {
   std::vector<std::pair<Rigid2D, int>> poses, pooled_poses;
   for (const Candidate& c : out) {
     poses.emplace_back(c.landed.transform, c.landed.offset);
     pooled_poses.emplace_back(c.landed.transform, pooledOffset(c.landed.offset));
   }
-  std::vector<std::vector<SliceLanding>> slices = landSlices(target.occupancy, source.occupancy, poses, dp);
+  std::vector<std::vector<SliceLanding>> slices = land.slices(poses);
   std::vector<std::vector<SliceLanding>> pooled_slices;
   if (target.grid < dp.finest_empty_cell - 1e-9)
     pooled_slices = landSlices(pooled(target.occupancy), pooled(source.occupancy), pooled_poses, dp);
@@ -95,7 +96,7 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
   // a climb takes seconds); two proposals are one place within looksApart
   // at the source's centre and the smear of heights.
   if (!denseSearchable(target.occupancy) || !denseSearchable(source.occupancy))
-    return finished(std::move(out), target, source, dp, votes);
+    return finished(std::move(out), land, target, source, dp, votes);
   std::vector<size_t> order(out.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
@@ -114,7 +115,7 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
     climbed.push_back(i);
     c.landed = uphill(land, target.occupancy, source.occupancy, c.proposed, c.proposed_offset, dp);
   }
-  return finished(std::move(out), target, source, dp, votes);
+  return finished(std::move(out), land, target, source, dp, votes);
 }
 
 }  // namespace tomomap

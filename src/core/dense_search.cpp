@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <future>
 #include <iterator>
 #include <limits>
 #include <map>
 #include <memory>
 #include <optional>
 #include <tuple>
+#include <utility>
 
 #include "bit_raster.hpp"
 #include "dense_refine.hpp"
@@ -260,6 +262,30 @@ std::vector<Cell> tellingOf(const std::vector<Cell>& cells) {
   return out;
 }
 
+/// One map's occupancy as a pose is judged on it: its slices dilated, its
+/// cells (and the telling ones alone) and the space it encloses.
+struct JudgedMap {
+  std::vector<BitRaster> dilated;
+  std::vector<Cell> cells, telling;
+  Enclosure encloses;
+
+  JudgedMap(const SliceStack& s, const DenseSearchParams& params)
+      : dilated(dilatedSlices(s, params)),
+        cells(cellsOf(s, params.wall_spread)),
+        telling(tellingOf(cells)),
+        encloses(s) {}
+};
+
+/// The target's and the source's JudgedMap, the two side by side where
+/// `params` has threads for it: on a building at 0.05 m cells preparing them
+/// took 0.2 s, one after the other.
+std::pair<JudgedMap, JudgedMap> judgedMaps(const SliceStack& t, const SliceStack& s, const DenseSearchParams& params) {
+  if (params.threads < 2) return {JudgedMap(t, params), JudgedMap(s, params)};
+  auto source = std::async(std::launch::async, [&] { return JudgedMap(s, params); });
+  JudgedMap target(t, params);
+  return {std::move(target), source.get()};
+}
+
 /// What a pose is judged on, built once per pair of maps: both maps' dilated
 /// occupancy, their cells and the space each saw empty.
 struct PoseJudge {
@@ -272,19 +298,7 @@ struct PoseJudge {
   const Enclosure *in_target, *in_source;  ///< null on cells too fine to read empty space
 
   PoseJudge(const SliceStack& t, const SliceStack& s, const DenseSearchParams& params)
-      : target(t),
-        source(s),
-        dilated(dilatedSlices(t, params)),
-        source_dilated(dilatedSlices(s, params)),
-        source_cells(cellsOf(s, params.wall_spread)),
-        target_cells(cellsOf(t, params.wall_spread)),
-        source_telling(tellingOf(source_cells)),
-        target_telling(tellingOf(target_cells)),
-        target_encloses(t),
-        source_encloses(s),
-        target_seen(footprint(dilated)),
-        in_target(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &target_encloses : nullptr),
-        in_source(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &source_encloses : nullptr) {}
+      : PoseJudge(t, s, params, judgedMaps(t, s, params)) {}
 
   /// The source's cells, landed on the target's raster at `landing`, at height `offset`.
   Tally forth(const std::vector<int>& landing, int offset) const {
@@ -312,6 +326,24 @@ struct PoseJudge {
           countInliers(source_dilated, target_telling, back_telling, -offset, target.size(), in_source));
     return p.score();
   }
+
+ private:
+  /// The judge of the two maps prepared (judgedMaps), their parts moved in.
+  PoseJudge(const SliceStack& t, const SliceStack& s, const DenseSearchParams& params,
+            std::pair<JudgedMap, JudgedMap>&& maps)
+      : target(t),
+        source(s),
+        dilated(std::move(maps.first.dilated)),
+        source_dilated(std::move(maps.second.dilated)),
+        source_cells(std::move(maps.second.cells)),
+        target_cells(std::move(maps.first.cells)),
+        source_telling(std::move(maps.second.telling)),
+        target_telling(std::move(maps.first.telling)),
+        target_encloses(std::move(maps.first.encloses)),
+        source_encloses(std::move(maps.second.encloses)),
+        target_seen(footprint(dilated)),
+        in_target(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &target_encloses : nullptr),
+        in_source(t.grid.cell >= params.finest_empty_cell - 1e-9 ? &source_encloses : nullptr) {}
 };
 
 /// `poses` by transform: the indices of the poses of each distinct one, told
@@ -356,19 +388,14 @@ void forEachLanding(const PoseJudge& judge, const PoseLander::Poses& poses, cons
 std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, const SliceStack& source,
                                                   const std::vector<std::pair<Rigid2D, int>>& poses,
                                                   const DenseSearchParams& params) {
-  if (target.partial || source.partial) return {};
-  const PoseJudge judge(target, source, params);
-  std::vector<std::vector<SliceLanding>> out(poses.size());
-  for (size_t n = 0; n < poses.size(); ++n)
-    countInliers(judge.dilated, judge.source_cells, landings(judge.source_cells, poses[n].first, target.grid),
-                 poses[n].second, source.size(), judge.in_target, &judge.target_seen, &out[n]);
-  return out;
+  return PoseLander(target, source, params).slices(poses);
 }
 
 PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params) {
   if (target.partial || source.partial) {
     land_ = [](const Poses&) { return std::vector<DensePose>{}; };
     score_ = [](const Poses&) { return std::vector<double>{}; };
+    slices_ = [](const Poses&) { return std::vector<std::vector<SliceLanding>>{}; };
     return;
   }
   const auto judge = std::make_shared<const PoseJudge>(target, source, params);
@@ -391,11 +418,22 @@ PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const
                    });
     return out;
   };
+  slices_ = [judge, threads](const Poses& poses) {
+    std::vector<std::vector<SliceLanding>> out(poses.size());
+#pragma omp parallel for schedule(dynamic) num_threads(threads)
+    for (size_t n = 0; n < poses.size(); ++n)
+      countInliers(judge->dilated, judge->source_cells,
+                   landings(judge->source_cells, poses[n].first, judge->target.grid), poses[n].second,
+                   judge->source.size(), judge->in_target, &judge->target_seen, &out[n]);
+    return out;
+  };
 }
 
 std::vector<DensePose> PoseLander::operator()(const Poses& poses) const { return land_(poses); }
 
 std::vector<double> PoseLander::scores(const Poses& poses) const { return score_(poses); }
+
+std::vector<std::vector<SliceLanding>> PoseLander::slices(const Poses& poses) const { return slices_(poses); }
 
 std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& source,
                                  const std::vector<std::pair<Rigid2D, int>>& poses, const DenseSearchParams& params) {

@@ -116,8 +116,8 @@ struct SliceLanding {
 };
 
 /// Each pose (T, offset) landed slice by slice, the source's cells on the
-/// target alone (diagnostics: the candidates' landings); empty where either
-/// stack is partial.
+/// target alone (the candidates' landings, candidates.hpp); empty where
+/// either stack is partial. PoseLander::slices with the stacks prepared once.
 std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, const SliceStack& source,
                                                   const std::vector<std::pair<Rigid2D, int>>& poses,
                                                   const DenseSearchParams& params = {});
@@ -135,10 +135,13 @@ class PoseLander {
   /// (the only ones it weighs): for a caller that ranks many poses and lands
   /// only the best (a climb, nearby_poses.hpp). Empty where either stack is partial.
   std::vector<double> scores(const Poses& poses) const;
+  /// Each pose landed slice by slice (landSlices); empty where either stack is partial.
+  std::vector<std::vector<SliceLanding>> slices(const Poses& poses) const;
 
  private:
   std::function<std::vector<DensePose>(const Poses&)> land_;
   std::function<std::vector<double>(const Poses&)> score_;
+  std::function<std::vector<std::vector<SliceLanding>>(const Poses&)> slices_;
 };
 
 /// landPose with a lander: (T, offset) landed, nothing landed (all counts 0)
