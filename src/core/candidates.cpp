@@ -115,6 +115,19 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
     climbed.push_back(i);
     c.landed = uphill(land, target.occupancy, source.occupancy, c.proposed, c.proposed_offset, dp);
   }
+  // Each at the height where most of the source's occupancy lands, within
+  // the smear of heights around its own, as the verdict places its answer
+  // (dense_opinion.cpp, takeOccupancyHeight): a climb weighs the telling
+  // cells alone, and a room's floor and ceiling are not telling.
+  PoseLander::Poses moved;
+  std::vector<size_t> which;
+  for (size_t i = 0; i < out.size(); ++i) {
+    const DensePose& p = out[i].landed;
+    const int offset = land.heightOffset(p.transform, p.offset, kSmearSlices / 2);
+    if (offset != p.offset) moved.emplace_back(p.transform, offset), which.push_back(i);
+  }
+  const std::vector<DensePose> relanded = land(moved);
+  for (size_t k = 0; k < which.size() && k < relanded.size(); ++k) out[which[k]].landed = relanded[k];
   return finished(std::move(out), land, target, source, dp, votes);
 }
 

@@ -396,6 +396,7 @@ PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const
     land_ = [](const Poses&) { return std::vector<DensePose>{}; };
     score_ = [](const Poses&) { return std::vector<double>{}; };
     slices_ = [](const Poses&) { return std::vector<std::vector<SliceLanding>>{}; };
+    height_ = [](const Rigid2D&, int middle, int) { return middle; };
     return;
   }
   const auto judge = std::make_shared<const PoseJudge>(target, source, params);
@@ -427,6 +428,10 @@ PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const
                    judge->source.size(), judge->in_target, &judge->target_seen, &out[n]);
     return out;
   };
+  height_ = [judge](const Rigid2D& T, int middle, int reach) {
+    return mostInliersAt(judge->dilated, judge->source_cells, landings(judge->source_cells, T, judge->target.grid),
+                         middle - reach, 2 * reach + 1, middle);
+  };
 }
 
 std::vector<DensePose> PoseLander::operator()(const Poses& poses) const { return land_(poses); }
@@ -434,6 +439,8 @@ std::vector<DensePose> PoseLander::operator()(const Poses& poses) const { return
 std::vector<double> PoseLander::scores(const Poses& poses) const { return score_(poses); }
 
 std::vector<std::vector<SliceLanding>> PoseLander::slices(const Poses& poses) const { return slices_(poses); }
+
+int PoseLander::heightOffset(const Rigid2D& T, int middle, int reach) const { return height_(T, middle, reach); }
 
 std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& source,
                                  const std::vector<std::pair<Rigid2D, int>>& poses, const DenseSearchParams& params) {

@@ -137,11 +137,14 @@ class PoseLander {
   std::vector<double> scores(const Poses& poses) const;
   /// Each pose landed slice by slice (landSlices); empty where either stack is partial.
   std::vector<std::vector<SliceLanding>> slices(const Poses& poses) const;
+  /// occupancyHeightOffset on the occupancy prepared; `middle` where either stack is partial.
+  int heightOffset(const Rigid2D& T, int middle, int reach) const;
 
  private:
   std::function<std::vector<DensePose>(const Poses&)> land_;
   std::function<std::vector<double>(const Poses&)> score_;
   std::function<std::vector<std::vector<SliceLanding>>(const Poses&)> slices_;
+  std::function<int(const Rigid2D&, int, int)> height_;
 };
 
 /// landPose with a lander: (T, offset) landed, nothing landed (all counts 0)

@@ -305,7 +305,8 @@ TEST(Cli, CandidatesListEveryProposedPoseScoredWithItsError) {
   bool best_right = false;
   for (const auto& c : j["candidates"]) {
     from.insert(c["from"].get<std::string>());
-    EXPECT_GE(c["refined"]["score"].get<double>(), c["proposed"]["score"].get<double>()) << "a climb only goes up";
+    EXPECT_GE(c["refined"]["score"].get<double>(), c["proposed"]["score"].get<double>())
+        << "on this room refining (a climb, the occupancy's height) only gains";
     if (c["refined"]["score"].get<double>() > best_score) {
       best_score = c["refined"]["score"].get<double>();
       best_right = c["error"]["success"].get<bool>();
