@@ -92,9 +92,11 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
     c.proposed_landed = c.landed = as_proposed[i];
     out.push_back(std::move(c));
   }
-  // The best distinct places as proposed climb (small maps: on a large one
-  // a climb takes seconds); two proposals are one place within looksApart
-  // at the source's centre and the smear of heights.
+  // The best distinct places as proposed climb, and every one takes the
+  // occupancy's height (small maps: on a large one a climb takes seconds,
+  // and its occupancy's height is not read, dense_opinion.cpp); two
+  // proposals are one place within looksApart at the source's centre and
+  // the smear of heights.
   if (!denseSearchable(target.occupancy) || !denseSearchable(source.occupancy))
     return finished(std::move(out), land, target, source, dp, votes);
   std::vector<size_t> order(out.size());
@@ -116,9 +118,9 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
     c.landed = uphill(land, target.occupancy, source.occupancy, c.proposed, c.proposed_offset, dp);
   }
   // Each at the height where most of the source's occupancy lands, within
-  // the smear of heights around its own, as the verdict places its answer
-  // (dense_opinion.cpp, takeOccupancyHeight): a climb weighs the telling
-  // cells alone, and a room's floor and ceiling are not telling.
+  // half the smear of heights either side of its own, as the verdict places
+  // its answer (dense_opinion.cpp, takeOccupancyHeight): a climb weighs the
+  // telling cells alone, and a room's floor and ceiling are not telling.
   PoseLander::Poses moved;
   std::vector<size_t> which;
   for (size_t i = 0; i < out.size(); ++i) {

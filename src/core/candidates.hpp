@@ -16,12 +16,14 @@ namespace tomomap {
 struct Candidate {
   enum class From { features, feature_rival, search_at_grid, search_wide, search_pooled };
   From from = From::features;
-  int rank = 0;                      ///< its rank among its search's proposals (0: that search's best)
-  int feature_support = 0;           ///< agreeing slice pairs behind it (from features only)
-  Rigid2D proposed;                  ///< as its search proposed it
-  int proposed_offset = 0;           ///< [slices]
-  DensePose proposed_landed;         ///< the proposal landed as it is
-  DensePose landed;                  ///< refined (uphill, where it climbed) and landed
+  int rank = 0;               ///< its rank among its search's proposals (0: that search's best)
+  int feature_support = 0;    ///< agreeing slice pairs behind it (from features only)
+  Rigid2D proposed;           ///< as its search proposed it
+  int proposed_offset = 0;    ///< [slices]
+  DensePose proposed_landed;  ///< the proposal landed as it is
+  /// Refined (uphill, where it climbed; at the occupancy's height, on maps
+  /// small enough for a dense search) and landed: the pose judged.
+  DensePose landed;
   std::vector<SliceLanding> slices;  ///< `landed`, source slice by source slice
   /// `landed` on the occupancy pooled to twice the cell, slice by slice
   /// (pooled slices), for maps finer than DenseSearchParams::finest_empty_cell:
@@ -57,8 +59,10 @@ struct Proposal {
 
 /// Every proposal landed on the maps' occupancy as the dense search lands its
 /// poses (dense_search.hpp); on maps small enough for that search, the
-/// kMostClimbs best distinct places climb uphill (nearby_poses.hpp), the rest
-/// stay as proposed. Empty where either map's occupancy is partial.
+/// kMostClimbs best distinct places climb uphill (nearby_poses.hpp), and then
+/// every one takes the occupancy's height within half the smear of its own
+/// (PoseLander::heightOffset); on larger maps they stay as proposed. Empty
+/// where either map's occupancy is partial.
 std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeatures& source,
                                      const std::vector<Proposal>& proposals, const MatchParams& params,
                                      const FeatureVotes& votes = {});

@@ -239,6 +239,14 @@ int mostInliersAt(const std::vector<BitRaster>& dilated, const std::vector<Cell>
   return lowest + static_cast<int>(best);
 }
 
+/// The height offset within `reach` slices of `middle` at which `T` lands
+/// the most source `cells` on the `dilated` target slices of raster `grid`
+/// (occupancyHeightOffset).
+int mostInliersNear(const std::vector<BitRaster>& dilated, const std::vector<Cell>& cells, const SliceGrid& grid,
+                    const Rigid2D& T, int middle, int reach) {
+  return mostInliersAt(dilated, cells, landings(cells, T, grid), middle - reach, 2 * reach + 1, middle);
+}
+
 /// Every slice's occupancy grown by inlier_radius_cells (BitRaster::disk): a
 /// cell lands on the stack where its pixel is set.
 std::vector<BitRaster> dilatedSlices(const SliceStack& stack, const DenseSearchParams& params) {
@@ -299,10 +307,14 @@ struct PoseJudge {
 
   PoseJudge(const SliceStack& t, const SliceStack& s, const DenseSearchParams& params)
       : PoseJudge(t, s, params, judgedMaps(t, s, params)) {}
+  // Its enclosures are pointed at (in_target, in_source): a copy would point at the original's.
+  PoseJudge(const PoseJudge&) = delete;
+  PoseJudge& operator=(const PoseJudge&) = delete;
 
-  /// The source's cells, landed on the target's raster at `landing`, at height `offset`.
-  Tally forth(const std::vector<int>& landing, int offset) const {
-    return countInliers(dilated, source_cells, landing, offset, source.size(), in_target, &target_seen);
+  /// The source's cells, landed on the target's raster at `landing`, at
+  /// height `offset` (and slice by slice into `per_slice`, if given).
+  Tally forth(const std::vector<int>& landing, int offset, std::vector<SliceLanding>* per_slice = nullptr) const {
+    return countInliers(dilated, source_cells, landing, offset, source.size(), in_target, &target_seen, per_slice);
   }
   /// The target's cells landed back on the source (at `back`) at height `offset`.
   Tally backwards(const std::vector<int>& back, int offset) const {
@@ -423,14 +435,11 @@ PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const
     std::vector<std::vector<SliceLanding>> out(poses.size());
 #pragma omp parallel for schedule(dynamic) num_threads(threads)
     for (size_t n = 0; n < poses.size(); ++n)
-      countInliers(judge->dilated, judge->source_cells,
-                   landings(judge->source_cells, poses[n].first, judge->target.grid), poses[n].second,
-                   judge->source.size(), judge->in_target, &judge->target_seen, &out[n]);
+      judge->forth(landings(judge->source_cells, poses[n].first, judge->target.grid), poses[n].second, &out[n]);
     return out;
   };
   height_ = [judge](const Rigid2D& T, int middle, int reach) {
-    return mostInliersAt(judge->dilated, judge->source_cells, landings(judge->source_cells, T, judge->target.grid),
-                         middle - reach, 2 * reach + 1, middle);
+    return mostInliersNear(judge->dilated, judge->source_cells, judge->target.grid, T, middle, reach);
   };
 }
 
@@ -460,9 +469,8 @@ DensePose landPose(const SliceStack& target, const SliceStack& source, const Rig
 
 int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
                           const DenseSearchParams& params) {
-  const std::vector<Cell> cells = cellsOf(source, params.wall_spread);
-  return mostInliersAt(dilatedSlices(target, params), cells, landings(cells, T, target.grid), middle - reach,
-                       2 * reach + 1, middle);
+  return mostInliersNear(dilatedSlices(target, params), cellsOf(source, params.wall_spread), target.grid, T, middle,
+                         reach);
 }
 
 bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params) {

@@ -1,9 +1,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <tuple>
 
+#include "core/candidates.hpp"
 #include "core/dense_refine.hpp"
 #include "core/dense_search.hpp"
+#include "core/matcher.hpp"
 #include "core/nearby_poses.hpp"
 #include "core/verdict.hpp"
 #include "core/voxel_filter.hpp"
@@ -265,9 +269,27 @@ TEST(DenseSearch, ScoresAloneAreTheLandedPosesScores) {
   }
   EXPECT_GT(scores[1], scores[5]);  // the room on itself lands more than off it
   EXPECT_TRUE(land.scores({}).empty());
+  // Slice by slice, and the occupancy's height, the same from the lander
+  // (its two maps prepared on two threads) as each prepared for one call.
+  const auto slices = land.slices(poses), alone = landSlices(room, room, poses);
+  ASSERT_EQ(slices.size(), poses.size());
+  ASSERT_EQ(alone.size(), poses.size());
+  for (size_t n = 0; n < poses.size(); ++n) {
+    SCOPED_TRACE(n);
+    ASSERT_EQ(slices[n].size(), alone[n].size());
+    for (size_t k = 0; k < slices[n].size(); ++k) {
+      const SliceLanding &a = slices[n][k], &b = alone[n][k];
+      EXPECT_EQ(std::tie(a.slice, a.cells, a.telling, a.seen, a.on, a.telling_on, a.contradicted),
+                std::tie(b.slice, b.cells, b.telling, b.seen, b.on, b.telling_on, b.contradicted));
+    }
+    EXPECT_EQ(land.heightOffset(poses[n].first, poses[n].second, 5),
+              occupancyHeightOffset(room, room, poses[n].first, poses[n].second, 5));
+  }
   SliceStack partial = room;
   partial.partial = true;  // some slices came over the network as features
   EXPECT_TRUE(PoseLander(room, partial).scores(poses).empty());
+  EXPECT_TRUE(PoseLander(room, partial).slices(poses).empty());
+  EXPECT_EQ(PoseLander(room, partial).heightOffset(Rigid2D{}, 3, 5), 3);
   const DensePose around = bestAround(room, partial, Rigid2D{}, 0, 5, 20);
   EXPECT_EQ(around.offset, 0);
   EXPECT_EQ(around.telling_inliers, 0u);
@@ -289,6 +311,32 @@ TEST(DenseSearch, TheOccupancysHeightIsWhereMostCellsLandTheOneAskedAboutOnATie)
   EXPECT_EQ(occupancyHeightOffset(five, one, Rigid2D{}, -3, 1), -3);  // nothing lands: the offset asked about
   EXPECT_EQ(occupancyHeightOffset(gaps, one, Rigid2D{}, 3, 3), 1);
   EXPECT_EQ(occupancyHeightOffset(gaps, one, Rigid2D{}, 2, 1), 2);
+}
+
+// Two proposals of the right pose at wrong heights are one place: only the
+// one that lands more climbs. Both are judged at the height where most of
+// the source's occupancy lands (a climb weighs the telling cells alone, and
+// a room's floor and ceiling are not telling), the right one.
+TEST(Candidates, AreJudgedAtTheHeightWhereTheOccupancyLandsMost) {
+  const Points room = roomScan();
+  const Pose4 moved{1.1, -0.6, 0.4, radians(35)};
+  const Pose4 back = Pose4::fromMatrix(moved.matrix().inverse());
+  Points source;
+  for (const auto& p : room) source.push_back((back.matrix() * p.cast<double>().homogeneous()).head<3>().cast<float>());
+  MatchParams params;
+  params.grid = kGrid;
+  const MapFeatures t = describeMap(room, params), s = describeMap(source, params);
+  ASSERT_TRUE(denseSearchable(t.occupancy));
+  const int right =
+      static_cast<int>(std::lround((moved.z - (t.occupancy.grid.z_min - s.occupancy.grid.z_min)) / kGrid));
+  const std::vector<Proposal> proposals{{Candidate::From::features, 0, 0, planar(moved), right + 2},
+                                        {Candidate::From::feature_rival, 1, 0, planar(moved), right - 3}};
+  const std::vector<Candidate> candidates = refineAndLand(t, s, proposals, params);
+  ASSERT_EQ(candidates.size(), 2u);
+  for (const Candidate& c : candidates) {
+    SCOPED_TRACE(fromName(c.from));
+    EXPECT_NEAR(c.landed.offset, right, 1);
+  }
 }
 
 // The room on itself, started a few hundredths of a metre and a few
