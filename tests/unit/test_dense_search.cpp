@@ -39,9 +39,7 @@ const ConsensusParams kSame{5 * kGrid, radians(10)};
 TEST(DenseSearch, FindsARoomTurnedAndShiftedAndLeadsTheTurnsThatFitItsWalls) {
   const Points room = roomScan();
   const Pose4 moved{1.7, -2.3, 0.4, radians(117)};
-  const Pose4 back = Pose4::fromMatrix(moved.matrix().inverse());
-  Points source;
-  for (const auto& p : room) source.push_back((back.matrix() * p.cast<double>().homogeneous()).head<3>().cast<float>());
+  const Points source = transformPoints(room, Pose4::fromMatrix(moved.matrix().inverse()));
   const SliceStack t = stackOf(room), s = stackOf(source);
   ASSERT_TRUE(denseSearchable(t));
 
@@ -320,9 +318,7 @@ TEST(DenseSearch, TheOccupancysHeightIsWhereMostCellsLandTheOneAskedAboutOnATie)
 TEST(Candidates, AreJudgedAtTheHeightWhereTheOccupancyLandsMost) {
   const Points room = roomScan();
   const Pose4 moved{1.1, -0.6, 0.4, radians(35)};
-  const Pose4 back = Pose4::fromMatrix(moved.matrix().inverse());
-  Points source;
-  for (const auto& p : room) source.push_back((back.matrix() * p.cast<double>().homogeneous()).head<3>().cast<float>());
+  const Points source = transformPoints(room, Pose4::fromMatrix(moved.matrix().inverse()));
   MatchParams params;
   params.grid = kGrid;
   const MapFeatures t = describeMap(room, params), s = describeMap(source, params);
