@@ -76,9 +76,10 @@ std::string fileNameOf(std::string name) {
 }
 
 /// One run of `method` on `p`; with `candidates`, tomomap lists its
-/// candidates and the run's JSON is kept as OUT/results/PAIR.METHOD.json.
+/// candidates and the run's JSON is kept as OUT/results/PAIR.METHOD.json;
+/// tomomap answers by `decision` (tomomap match --decision).
 Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratch, int threads, double timeout_s,
-           bool candidates) {
+           bool candidates, const std::string& decision) {
   Row row;
   row.pair = p.name;
   row.noise = p.noise;
@@ -93,6 +94,7 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   else
     argv = {siblingBinary("tomomap-baseline"), "--method", method};
   if (method == "tomomap" && candidates) argv.push_back("--candidates");
+  if (method == "tomomap") argv.insert(argv.end(), {"--decision", decision});
   for (const auto& a : {p.target, p.source, std::string("--grid"), std::to_string(p.grid), std::string("--json"), json,
                         std::string("--gt-target"), p.gt_target, std::string("--gt-source"), p.gt_source,
                         std::string("-j"), std::to_string(threads)})
@@ -131,10 +133,10 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
       row.candidate_decision = "refused";
     } else {
       // Judged as the verdict's answer is: finished in 6-DoF where the finish held.
-      const auto& decision = j["candidate_decision"];
+      const auto& trial = j["candidate_decision"];
       const nlohmann::json picked =
-          decision.contains("finished_error")
-              ? decision["finished_error"]
+          trial.contains("finished_error")
+              ? trial["finished_error"]
               : j["candidates"].at(answer.get<size_t>()).value("error", nlohmann::json::object());
       row.candidate_decision = picked.value("success", false) ? "right" : "wrong";
     }
@@ -261,8 +263,9 @@ struct EvalOptions {
   int sequence_pairs = 10;
   std::vector<std::string> methods;
   int threads = 0;
-  double timeout_s = 0;     ///< per run; 0 = none
-  bool candidates = false;  ///< tomomap's runs list their candidates; every run's JSON kept in OUT/results
+  double timeout_s = 0;              ///< per run; 0 = none
+  bool candidates = false;           ///< tomomap's runs list their candidates; every run's JSON kept in OUT/results
+  std::string decision = "verdict";  ///< what answers tomomap's runs (tomomap match --decision)
 };
 
 /// The suite a user's own posed sequence stands for: `pairs` seeds of it, tomomap alone.
@@ -398,7 +401,7 @@ int runEval(const EvalOptions& o) {
     for (const auto& m : methodsOf(p)) {
       // Said before it starts: a baseline run can take minutes.
       std::cerr << "[" << rows.size() + 1 << "/" << total << "] " << p.name << " " << m << ": running\n";
-      Row r = runOne(p, m, out, o.threads, o.timeout_s, o.candidates);
+      Row r = runOne(p, m, out, o.threads, o.timeout_s, o.candidates, o.decision);
       rows.push_back(r);
       // Written as they finish: an interrupted run keeps every finished row.
       rows_csv << csv(r) << std::endl;
@@ -491,6 +494,9 @@ Command addEvalCommand(CLI::App& app) {
   sub->add_flag("--candidates", o->candidates,
                 "tomomap lists every candidate pose (tomomap match --candidates) and each run's JSON is kept in "
                 "OUT/results/: what the decision could have answered, pair by pair");
+  sub->add_option("--decision", o->decision, "what answers tomomap's runs (tomomap match --decision)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"verdict", "candidates"}));
   return {sub, [o] { return runEval(*o); }};
 }
 

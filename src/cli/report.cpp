@@ -284,10 +284,11 @@ void printCandidates(std::ostream& out, const MatchResult& r,
   }
   if (!r.candidate_verdict) return;
   const CandidateVerdict& v = *r.candidate_verdict;
+  const char* role = r.decision == Decision::candidates ? "(the answer)" : "(on trial, not the answer)";
   if (v.answer < 0)
-    out << "one decision     (on trial, not the answer) no reliable match: " << v.reason << "\n";
+    out << "one decision     " << role << " no reliable match: " << v.reason << "\n";
   else
-    out << format("one decision     (on trial, not the answer) %s (%d), %.1f sigma clear on %s over %d slices\n",
+    out << format("one decision     %s %s (%d), %.1f sigma clear on %s over %d slices\n", role,
                   fromName(r.candidates[static_cast<size_t>(v.answer)].from),
                   r.candidates[static_cast<size_t>(v.answer)].rank, v.lead_sigma, onName(v.on), v.slices);
   if (finished_check) out << "                 finished in 6-DoF: " << candidateErrorText(*finished_check) << "\n";
@@ -315,6 +316,7 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
     j["schema_version"] = kJsonSchemaVersion;
     j["tool"] = {{"name", how.method == "tomomap" ? "tomomap" : "tomomap-baseline"}, {"version", TOMOMAP_VERSION}};
     j["method"] = how.method;
+    if (how.method == "tomomap") j["decision"] = r.decision == Decision::candidates ? "candidates" : "verdict";
     j["grid"] = grid;
     if (extra.is_object()) j.update(extra);
     if (!r.candidates.empty()) j["candidates"] = candidatesJson(r, checks);

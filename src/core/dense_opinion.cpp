@@ -169,13 +169,16 @@ void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Propos
   std::vector<Proposal> proposals;
   if (feature) proposals.push_back(*feature);
   for (const Proposal& p : e.feature_rivals) proposals.push_back(p);
+  // Each search where it reaches (the wide one, on its finer coarse raster,
+  // reaches maps twice as large: LiDAR crops).
   if (denseSearchable(target.occupancy) && denseSearchable(source.occupancy)) {
     const SliceStack ft = fullSlices(target.occupancy), fs = fullSlices(source.occupancy);
     if (!at_grid) at_grid = searchAt(target, source, ft, fs, 1, params);
-    if (!wide) wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch());
     if (!at_pooled && 2 * target.grid <= kBars.coarsest_pooled_cell + 1e-9)
       at_pooled = searchAt(target, source, pooled(ft), pooled(fs), 2, params);
   }
+  if (!wide && denseSearchable(target.occupancy, wideSearch()) && denseSearchable(source.occupancy, wideSearch()))
+    wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch());
   for (const auto& [o, from] :
        {std::pair{&at_grid, Candidate::From::search_at_grid}, std::pair{&wide, Candidate::From::search_wide},
         std::pair{&at_pooled, Candidate::From::search_pooled}})
@@ -185,6 +188,27 @@ void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Propos
             {from, static_cast<int>(i), 0, (*o)->search.poses[i].transform, (*o)->search.poses[i].offset});
   r.candidates = refineAndLand(target, source, proposals, params, e.feature_votes);
   r.candidate_verdict = decideOnCandidates(r.candidates, params, target.grid, source.occupancy.grid.centre());
+}
+
+/// `r` answered by the decision over the candidates (allCandidates): the
+/// candidate it names, as it judged it.
+void answerByCandidates(MatchResult& r, const Evidence& e, const MapFeatures& target, const MapFeatures& source) {
+  r.decision = Decision::candidates;
+  const CandidateVerdict& v = *r.candidate_verdict;
+  r.reliable = v.answer >= 0;
+  r.reason = v.reason;
+  if (r.candidates.empty()) {
+    if (target.occupancy.partial || source.occupancy.partial)
+      r.reason += ": a map's occupancy is not whole (a peer's slices sent without it), and candidates land on it";
+    else if (!e.features.missing.empty())
+      r.reason += ": " + e.features.missing;
+  }
+  if (!r.reliable) return;
+  const Candidate& c = r.candidates[static_cast<size_t>(v.answer)];
+  r.T_target_source = poseAt(c.landed.transform, c.landed.offset, target, source);
+  r.height_offset = c.landed.offset;
+  r.answered_by = c.from;
+  r.lead_sigma = v.lead_sigma;
 }
 
 }  // namespace
@@ -198,6 +222,16 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
                                                   planar(r.T_target_source), r.height_offset})
                : std::nullopt;
   std::optional<Opinion> at_grid, wide, at_pooled;
+  if (params.decision == Decision::candidates) {
+    if (!e.tilted.empty()) {
+      r.reliable = false, r.reason = e.tilted, r.decision = Decision::candidates;
+    } else {
+      allCandidates(r, e, feature, at_grid, wide, at_pooled, target, source, params);
+      answerByCandidates(r, e, target, source);
+    }
+    r.timings.dense = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return;
+  }
   // The searches that answer alone search the full slices alone (kFullSlice);
   // the pooled stacks are kept for the pooled pose's second look.
   std::optional<SliceStack> full_target, full_source, pooled_target, pooled_source;

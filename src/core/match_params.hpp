@@ -7,6 +7,10 @@
 
 namespace tomomap {
 
+/// What answers a match: the verdict (verdict.hpp), or the one decision over
+/// the candidates (candidate_decision.hpp), on trial until it may replace it.
+enum class Decision { verdict, candidates };
+
 struct MatchParams {
   double grid = 0.05;  ///< voxel, pixel and slice size g [m]; 0.05 indoors, 0.2-0.5 outdoors
   FeatureParams features;
@@ -42,7 +46,17 @@ struct MatchParams {
   /// the occupancy (MatchResult::candidates): what the decision could have
   /// answered. Diagnostics: every search runs, seconds more on small maps.
   bool candidates = false;
+  /// What answers (Decision): with Decision::candidates the candidates are
+  /// gathered as `candidates` asks, the decision over them answers, and the
+  /// verdict does not run. That decision needs the maps' occupancy (a peer's
+  /// slices sent without it give no candidate).
+  Decision decision = Decision::verdict;
 };
+
+/// Whether a match gathers the candidates: asked for, or they decide.
+inline bool gathersCandidates(const MatchParams& params) {
+  return params.candidates || params.decision == Decision::candidates;
+}
 
 /// Called with (stage name, done, total) as work advances; may be empty.
 using Progress = std::function<void(const char*, size_t, size_t)>;

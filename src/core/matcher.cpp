@@ -97,7 +97,7 @@ void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const 
     }
   f.support = static_cast<int>(best.consensus.support());
   f.height_offset = best.offset;
-  if (params.candidates) {
+  if (gathersCandidates(params)) {
     // Every slice pair's estimate with its source slice and height offset, for the candidates' votes.
     struct Vote {
       int source_slice, offset;
@@ -246,7 +246,11 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
       r.T_target_source = fourDofAbout(answer, occupancyCentre(source.occupancy));
     }
   }
-  if (r.candidate_verdict && r.candidate_verdict->answer >= 0 && params.finish) {
+  if (r.candidate_verdict && r.candidate_verdict->answer >= 0 && params.decision == Decision::candidates) {
+    // Its answer is the one just finished.
+    if (r.finish && r.finish->held)
+      r.candidate_verdict->finished = betweenOwnFrames(r.finish->T_target_source, target.slicedUp(), source.slicedUp());
+  } else if (r.candidate_verdict && r.candidate_verdict->answer >= 0 && params.finish) {
     // The decision on trial's answer, finished as the verdict's is (its time
     // counted with the finish's).
     const auto t0 = Clock::now();

@@ -102,11 +102,14 @@ struct MatchResult {
   int target_slices = 0, source_slices = 0;
   size_t target_features = 0, source_features = 0;
   StageTimings timings;
-  /// With MatchParams::candidates: every candidate pose the searches
-  /// proposed, refined and landed (candidates.hpp).
+  /// What answered (MatchParams::decision).
+  Decision decision = Decision::verdict;
+  /// Where the match gathers candidates (gathersCandidates): every candidate
+  /// pose the searches proposed, refined and landed (candidates.hpp).
   std::vector<Candidate> candidates;
-  /// With MatchParams::candidates: the decision over them, on trial beside
-  /// the verdict (candidate_decision.hpp); it changes no answer.
+  /// Where the match gathers candidates: the decision over them
+  /// (candidate_decision.hpp); the answer with Decision::candidates, on trial
+  /// beside the verdict otherwise (it then changes no answer).
   std::optional<CandidateVerdict> candidate_verdict;
 };
 

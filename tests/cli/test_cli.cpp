@@ -331,6 +331,49 @@ TEST(Cli, CandidatesListEveryProposedPoseScoredWithItsError) {
   EXPECT_FALSE(nlohmann::json::parse(std::ifstream(dir / "p.json")).contains("candidates")) << "only when asked";
 }
 
+// --decision candidates: the one decision over the candidates answers, and
+// the pose it returns is the candidate it judged (the verdict does not run).
+TEST(Cli, TheDecisionOverTheCandidatesAnswersWithThePoseItJudged) {
+  TempDir dir;
+  const std::string w = dir / "room";
+  ASSERT_EQ(runTomomap("synth --world room --seed 1 --noise low --out " + w).exit_code, 0);
+  const std::string pair = "match " + w + "/map_0.pcd " + w + "/map_1.pcd --grid 0.1 --gt-target " + w +
+                           "/map_0-gtpose.txt --gt-source " + w + "/map_1-gtpose.txt";
+  for (const bool finish : {false, true}) {
+    const std::string json = dir / (finish ? "finished.json" : "judged.json");
+    const auto r = runTomomap(pair + " --decision candidates" + (finish ? "" : " --no-finish") + " --json " + json);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("one decision     (the answer) "), std::string::npos) << r.output;
+    const auto j = nlohmann::json::parse(std::ifstream(json));
+    EXPECT_EQ(j["decision"], "candidates");
+    ASSERT_TRUE(j["reliable"].get<bool>()) << j.dump();
+    const auto& decision = j["candidate_decision"];
+    ASSERT_FALSE(decision["answer"].is_null()) << decision.dump();
+    const auto& judged = j["candidates"].at(decision["answer"].get<size_t>());
+    EXPECT_EQ(j["answered_by"], judged["from"]);
+    EXPECT_DOUBLE_EQ(j["lead_sigma"].get<double>(), decision["lead_sigma"].get<double>());
+    EXPECT_EQ(j["height_offset_slices"], judged["refined"]["height_offset_slices"]);
+    EXPECT_TRUE(j["error"]["success"].get<bool>()) << j.dump();
+    if (!finish) {
+      // Unfinished, the answer is the judged candidate's pose, to rounding.
+      EXPECT_NEAR(j["error"]["translation"].get<double>(), judged["error"]["translation"].get<double>(), 1e-9);
+      EXPECT_NEAR(j["error"]["yaw"].get<double>(), judged["error"]["yaw"].get<double>(), 1e-9);
+      EXPECT_FALSE(decision.contains("finished")) << decision.dump();
+    } else {
+      // Finished, it is that pose finished in 6-DoF, and said so once.
+      ASSERT_TRUE(decision.value("finished", false)) << decision.dump();
+      EXPECT_NEAR(j["error"]["translation"].get<double>(), decision["finished_error"]["translation"].get<double>(),
+                  1e-9);
+    }
+  }
+  const auto verdict = runTomomap(pair + " --json " + (dir / "v.json"));
+  ASSERT_EQ(verdict.exit_code, 0) << verdict.output;
+  const auto v = nlohmann::json::parse(std::ifstream(dir / "v.json"));
+  EXPECT_EQ(v["decision"], "verdict") << "the verdict answers by default";
+  EXPECT_FALSE(v.contains("candidate_decision")) << "and gathers no candidates";
+  expectBadInput(runTomomap(pair + " --decision oracle"), "--decision");
+}
+
 namespace {
 
 /// Pixels of exactly this BGR colour.
@@ -424,6 +467,12 @@ TEST(Cli, ATiltedSynthMapIsLevelledAndRefusedWithNoLevel) {
       << refused.output;
   EXPECT_NE(refused.output.find("levelling is off"), std::string::npos) << refused.output;
   EXPECT_FALSE(nlohmann::json::parse(std::ifstream(dir / "refused.json"))["reliable"].get<bool>());
+  // The decision over the candidates refuses it as the verdict does: a tilted map's slices cut walls at a slant.
+  const auto also = runTomomap("match --no-level --decision candidates " + maps);
+  EXPECT_EQ(also.exit_code, 1) << also.output;
+  EXPECT_TRUE(std::regex_search(
+      also.output, std::regex(R"(no reliable match: source map is tilted 10\.0 \+- 0\.\d deg from gravity)")))
+      << also.output;
 }
 
 TEST(Cli, VizDrawsAsManySlicePairsAsAskedAndWritesJson) {
