@@ -15,6 +15,7 @@
 
 #include "child_process.hpp"
 #include "commands.hpp"
+#include "core/match_params.hpp"
 #include "core/stats.hpp"
 #include "exit_codes.hpp"
 #include "grid_option.hpp"
@@ -127,7 +128,9 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
     row.success = j["error"]["success"];
   }
   if (!row.reliable) row.note = j.value("reason", "");
-  if (j.contains("candidate_decision")) {
+  // The decision over the candidates beside the verdict; where it answers,
+  // its outcome is the row's own.
+  if (j.contains("candidate_decision") && j.value("decision", "") != decisionName(Decision::candidates)) {
     const auto& answer = j["candidate_decision"]["answer"];
     if (answer.is_null()) {
       row.candidate_decision = "refused";
@@ -257,15 +260,22 @@ cv::Mat boxPlots(const std::vector<Row>& rows, const std::vector<std::string>& m
       {viz::stack({drawBoxPanel(t), drawBoxPanel(y)}, false), viz::stack({drawBoxPanel(w), drawBoxPanel(m)}, false)});
 }
 
+/// Every decision's name (tomomap match --decision).
+std::vector<std::string> decisionNames() {
+  std::vector<std::string> out;
+  for (const Decision d : kDecisions) out.emplace_back(decisionName(d));
+  return out;
+}
+
 struct EvalOptions {
   std::string suite, out = "eval-out";
   SuiteSequence sequence;  ///< a user's own posed sequence, instead of a suite (--scans, --poses)
   int sequence_pairs = 10;
   std::vector<std::string> methods;
   int threads = 0;
-  double timeout_s = 0;              ///< per run; 0 = none
-  bool candidates = false;           ///< tomomap's runs list their candidates; every run's JSON kept in OUT/results
-  std::string decision = "verdict";  ///< what answers tomomap's runs (tomomap match --decision)
+  double timeout_s = 0;     ///< per run; 0 = none
+  bool candidates = false;  ///< tomomap's runs list their candidates; every run's JSON kept in OUT/results
+  std::string decision = decisionName(MatchParams{}.decision);  ///< what answers tomomap's runs (match --decision)
 };
 
 /// The suite a user's own posed sequence stands for: `pairs` seeds of it, tomomap alone.
@@ -496,7 +506,7 @@ Command addEvalCommand(CLI::App& app) {
                 "OUT/results/: what the decision could have answered, pair by pair");
   sub->add_option("--decision", o->decision, "what answers tomomap's runs (tomomap match --decision)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"verdict", "candidates"}));
+      ->check(CLI::IsMember(decisionNames()));
   return {sub, [o] { return runEval(*o); }};
 }
 

@@ -147,12 +147,13 @@ void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
   sub.add_flag("--candidates", o.params.candidates,
                "list every pose the searches proposed, refined and scored on the occupancy, with its error "
                "where ground truth is given (diagnostics: every search runs)");
+  std::map<std::string, Decision> decisions;
+  for (const Decision d : kDecisions) decisions[decisionName(d)] = d;
   sub.add_option("--decision", o.params.decision,
                  "what answers: the verdict, or the one decision over the candidates (on trial until it may "
-                 "replace the verdict; needs both maps' occupancy)")
-      ->transform(CLI::CheckedTransformer(
-          std::map<std::string, Decision>{{"verdict", Decision::verdict}, {"candidates", Decision::candidates}}))
-      ->default_str("verdict");
+                 "replace the verdict)")
+      ->transform(CLI::CheckedTransformer(decisions))
+      ->default_str(decisionName(MatchParams{}.decision));
   sub.add_flag("--exhaustive", o.params.exhaustive,
                "match every slice pair instead of the height offsets the descriptor index points to "
                "(same answers, n^2 cost; for checking)");

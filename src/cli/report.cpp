@@ -316,7 +316,7 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
     j["schema_version"] = kJsonSchemaVersion;
     j["tool"] = {{"name", how.method == "tomomap" ? "tomomap" : "tomomap-baseline"}, {"version", TOMOMAP_VERSION}};
     j["method"] = how.method;
-    if (how.method == "tomomap") j["decision"] = r.decision == Decision::candidates ? "candidates" : "verdict";
+    if (how.method == "tomomap") j["decision"] = decisionName(r.decision);
     j["grid"] = grid;
     if (extra.is_object()) j.update(extra);
     if (!r.candidates.empty()) j["candidates"] = candidatesJson(r, checks);

@@ -179,6 +179,10 @@ void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Propos
   }
   if (!wide && denseSearchable(target.occupancy, wideSearch()) && denseSearchable(source.occupancy, wideSearch()))
     wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch());
+  // Each search's lead, as the verdict's path records it, for the searches it did not ask for.
+  for (const auto& [o, lead] : {std::pair{&at_grid, &r.dense.at_grid_lead}, std::pair{&wide, &r.dense.wide_lead},
+                                std::pair{&at_pooled, &r.dense.pooled_lead}})
+    if (*o && (*o)->found() && *lead == 0) *lead = evidenceOf(**o, r, false, target, source).lead();
   for (const auto& [o, from] :
        {std::pair{&at_grid, Candidate::From::search_at_grid}, std::pair{&wide, Candidate::From::search_wide},
         std::pair{&at_pooled, Candidate::From::search_pooled}})
@@ -193,15 +197,13 @@ void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Propos
 /// `r` answered by the decision over the candidates (allCandidates): the
 /// candidate it names, as it judged it.
 void answerByCandidates(MatchResult& r, const Evidence& e, const MapFeatures& target, const MapFeatures& source) {
-  r.decision = Decision::candidates;
   const CandidateVerdict& v = *r.candidate_verdict;
   r.reliable = v.answer >= 0;
   r.reason = v.reason;
   if (r.candidates.empty()) {
-    if (target.occupancy.partial || source.occupancy.partial)
-      r.reason += ": a map's occupancy is not whole (a peer's slices sent without it), and candidates land on it";
-    else if (!e.features.missing.empty())
-      r.reason += ": " + e.features.missing;
+    if (!e.features.missing.empty()) r.reason += ": " + e.features.missing;
+    if (!denseSearchable(target.occupancy, wideSearch()) || !denseSearchable(source.occupancy, wideSearch()))
+      r.reason += "; the maps are too large for a dense search of their occupancy";
   }
   if (!r.reliable) return;
   const Candidate& c = r.candidates[static_cast<size_t>(v.answer)];
@@ -224,7 +226,7 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
   std::optional<Opinion> at_grid, wide, at_pooled;
   if (params.decision == Decision::candidates) {
     if (!e.tilted.empty()) {
-      r.reliable = false, r.reason = e.tilted, r.decision = Decision::candidates;
+      r.reliable = false, r.reason = e.tilted;
     } else {
       allCandidates(r, e, feature, at_grid, wide, at_pooled, target, source, params);
       answerByCandidates(r, e, target, source);

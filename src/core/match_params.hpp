@@ -11,6 +11,10 @@ namespace tomomap {
 /// the candidates (candidate_decision.hpp), on trial until it may replace it.
 enum class Decision { verdict, candidates };
 
+/// A decision's name ("verdict", "candidates"), as the CLI and the JSON give it.
+inline const char* decisionName(Decision d) { return d == Decision::candidates ? "candidates" : "verdict"; }
+inline constexpr Decision kDecisions[] = {Decision::verdict, Decision::candidates};
+
 struct MatchParams {
   double grid = 0.05;  ///< voxel, pixel and slice size g [m]; 0.05 indoors, 0.2-0.5 outdoors
   FeatureParams features;
@@ -48,8 +52,8 @@ struct MatchParams {
   bool candidates = false;
   /// What answers (Decision): with Decision::candidates the candidates are
   /// gathered as `candidates` asks, the decision over them answers, and the
-  /// verdict does not run. That decision needs the maps' occupancy (a peer's
-  /// slices sent without it give no candidate).
+  /// verdict does not run. That decision needs both maps' occupancy: a
+  /// daemon's peer slices may come without it, so the daemon keeps the verdict.
   Decision decision = Decision::verdict;
 };
 

@@ -219,6 +219,7 @@ MatchResult resultFor(const MapFeatures& target, const MapFeatures& source) {
 MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
                           const Progress& progress, PairCache* cache) {
   MatchResult r = resultFor(target, source);
+  r.decision = params.decision;
   Evidence e;
   e.grid = target.grid;
   auto tilted = tiltRefusal(target, "target", params);

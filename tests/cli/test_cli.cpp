@@ -360,7 +360,11 @@ TEST(Cli, TheDecisionOverTheCandidatesAnswersWithThePoseItJudged) {
       EXPECT_NEAR(j["error"]["yaw"].get<double>(), judged["error"]["yaw"].get<double>(), 1e-9);
       EXPECT_FALSE(decision.contains("finished")) << decision.dump();
     } else {
-      // Finished, it is that pose finished in 6-DoF, and said so once.
+      // Finished, it is that pose finished in 6-DoF: the finish held, moved
+      // it less than a cell, and the decision's own finish is the answer's.
+      ASSERT_TRUE(j["finish"]["held"].get<bool>()) << j["finish"].dump();
+      EXPECT_LT(j["finish"]["moved_m"].get<double>(), 0.1) << j["finish"].dump();
+      EXPECT_NEAR(j["error"]["translation"].get<double>(), judged["error"]["translation"].get<double>(), 0.1);
       ASSERT_TRUE(decision.value("finished", false)) << decision.dump();
       EXPECT_NEAR(j["error"]["translation"].get<double>(), decision["finished_error"]["translation"].get<double>(),
                   1e-9);
