@@ -247,11 +247,8 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
       r.T_target_source = fourDofAbout(answer, occupancyCentre(source.occupancy));
     }
   }
-  if (r.candidate_verdict && r.candidate_verdict->answer >= 0 && params.decision == Decision::candidates) {
-    // Its answer is the one just finished.
-    if (r.finish && r.finish->held)
-      r.candidate_verdict->finished = betweenOwnFrames(r.finish->T_target_source, target.slicedUp(), source.slicedUp());
-  } else if (r.candidate_verdict && r.candidate_verdict->answer >= 0 && params.finish) {
+  const bool candidate_answer = r.candidate_verdict && r.candidate_verdict->answer >= 0;
+  if (candidate_answer && params.decision == Decision::verdict && params.finish) {
     // The decision on trial's answer, finished as the verdict's is (its time
     // counted with the finish's).
     const auto t0 = Clock::now();
@@ -264,6 +261,9 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   }
   if (target.leveled || source.leveled || (r.finish && r.finish->held))
     r.T_target_source_6dof = betweenOwnFrames(answer, target.slicedUp(), source.slicedUp());
+  // Where the decision answered, its finish is the answer's.
+  if (candidate_answer && params.decision == Decision::candidates && r.finish && r.finish->held)
+    r.candidate_verdict->finished = r.T_target_source_6dof;
   return r;
 }
 
