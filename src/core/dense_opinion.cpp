@@ -107,8 +107,8 @@ void answer(MatchResult& r, const Opinion& o, const MapFeatures& target, const M
   r.height_offset = best.offset;
 }
 
-/// `r`'s pose moved uphill on the maps' occupancy (nearby_poses.hpp), where
-/// that lands more telling cells. The climb starts from `r`'s pose, or from
+/// `r`'s pose moved uphill on the maps' occupancy (nearby_poses.hpp, with
+/// `land`, a lander of it), where that lands more telling cells. The climb starts from `r`'s pose, or from
 /// whichever of `found` (each search's best pose, the features' answer) at
 /// its place lands more beyond chance: within the smear of heights and
 /// within looksApart at the source raster's centre. Searches on other
@@ -120,8 +120,8 @@ void answer(MatchResult& r, const Opinion& o, const MapFeatures& target, const M
 /// (climbed from it, the answer is 0.11 m off). A start that lands more
 /// within chance is no better: on a room (seed 14, high noise, g 0.05) one
 /// landing 5,724 against the answer's 5,688 climbed to 0.27 m off, not 0.13.
-void climbUphill(MatchResult& r, const std::vector<std::pair<Rigid2D, int>>& found, const MapFeatures& target,
-                 const MapFeatures& source, const MatchParams& params) {
+void climbUphill(MatchResult& r, const PoseLander& land, const std::vector<std::pair<Rigid2D, int>>& found,
+                 const MapFeatures& target, const MapFeatures& source, const MatchParams& params) {
   DenseSearchParams dp;
   dp.threads = matchThreads(params);
   const Rigid2D answer = planar(r.T_target_source);
@@ -131,8 +131,6 @@ void climbUphill(MatchResult& r, const std::vector<std::pair<Rigid2D, int>>& fou
   for (const auto& [T, offset] : found)
     if (onePlace(T, offset, answer, r.height_offset, same, source.occupancy.grid.centre()))
       starts.emplace_back(T, offset);
-  // One preparation of the occupancy lands the starts and serves the climb.
-  const PoseLander land(target.occupancy, source.occupancy, dp);
   const std::vector<DensePose> landed = land(starts);
   if (landed.empty()) return;
   const DensePose* start = &landed.front();
@@ -149,10 +147,14 @@ void climbUphill(MatchResult& r, const std::vector<std::pair<Rigid2D, int>>& fou
 /// On noisy rooms the height was up to 0.18 m off, this one's up to 0.06 m;
 /// on 7 of 29 demo-room moves one or two slices off, this one's within 1 mm
 /// (docs/results.md, "Height from occupancy"). Larger maps keep theirs.
-void takeOccupancyHeight(MatchResult& r, const MapFeatures& target, const MapFeatures& source) {
+/// `land`, where the answer climbed, is the climb's lander: the occupancy
+/// it prepared is the one this height is read on.
+void takeOccupancyHeight(MatchResult& r, const MapFeatures& target, const MapFeatures& source, const PoseLander* land) {
   if (!denseSearchable(target.occupancy) || !denseSearchable(source.occupancy)) return;
-  r.height_offset = occupancyHeightOffset(target.occupancy, source.occupancy, planar(r.T_target_source),
-                                          r.height_offset, kSmearSlices / 2);
+  const Rigid2D T = planar(r.T_target_source);
+  r.height_offset =
+      land ? land->heightOffset(T, r.height_offset, kSmearSlices / 2)
+           : occupancyHeightOffset(target.occupancy, source.occupancy, T, r.height_offset, kSmearSlices / 2);
   r.T_target_source.z = heightShift(target, source, r.height_offset);
 }
 
@@ -301,8 +303,16 @@ void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const M
   // it too; a clear feature winner, or one on a map too large to search, is
   // placed by its keypoints.
   const bool weighed = (e.at_grid && e.at_grid->found) || (e.wide && e.wide->found);
-  if (r.reliable && weighed) climbUphill(r, found, target, source, params);
-  if (r.reliable) takeOccupancyHeight(r, target, source);
+  // One preparation of the occupancy lands the climb's starts, serves the
+  // climb and reads the answer's height.
+  std::optional<PoseLander> land;
+  if (r.reliable && weighed) {
+    DenseSearchParams dp;
+    dp.threads = matchThreads(params);
+    land.emplace(target.occupancy, source.occupancy, dp);
+    climbUphill(r, *land, found, target, source, params);
+  }
+  if (r.reliable) takeOccupancyHeight(r, target, source, land ? &*land : nullptr);
   if (params.candidates) allCandidates(r, e, feature, at_grid, wide, at_pooled, target, source, params);
   r.timings.dense = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
