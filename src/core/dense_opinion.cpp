@@ -108,13 +108,13 @@ void answer(MatchResult& r, const Opinion& o, const MapFeatures& target, const M
 }
 
 /// `r`'s pose moved uphill on the maps' occupancy (nearby_poses.hpp, with
-/// `land`, a lander of it), where that lands more telling cells. The climb starts from `r`'s pose, or from
-/// whichever of `found` (each search's best pose, the features' answer) at
-/// its place lands more beyond chance: within the smear of heights and
-/// within looksApart at the source raster's centre. Searches on other
-/// rasters and slices stop on different hilltops of one place, and a climb
-/// from the lower one can stay there: on a real RGB-D crop (sunrgbd-room-164, g 0.05)
-/// the search at the grid (full slices) answered 0.28 m along two walls,
+/// `land`, a lander of it), where that lands more telling cells. The climb
+/// starts from `r`'s pose, or from whichever of `found` (each search's best
+/// pose, the features' answer) at its place lands more beyond chance: within
+/// the smear of heights and within looksApart at the source raster's
+/// centre. Searches on other rasters and slices stop on different hilltops
+/// of one place, and a climb from the lower one can stay there: on a real
+/// RGB-D crop (sunrgbd-room-164, g 0.05) the search at the grid (full slices) answered 0.28 m along two walls,
 /// landing 1,129 telling cells on every slice; the wide search's pose, 0.26 m
 /// from it, landed 1,297 (3.4 sigma more) and lay 0.06 m from the truth
 /// (climbed from it, the answer is 0.11 m off). A start that lands more
