@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "candidates.hpp"
+#include "verdict.hpp"
 
 namespace tomomap {
 
@@ -23,11 +24,15 @@ struct CandidateVerdict {
   /// The evidence it answered on: the occupancy the candidate lands on; or,
   /// where that does not tell, the occupancy's best place corroborated by a
   /// dense search's best pose and a feature estimate there; or the features'
-  /// slice-pair estimates it agrees with.
-  enum class On { occupancy, corroborated, feature_votes } on = On::occupancy;
-  double lead_sigma = 0;  ///< the answer's lead over the best candidate elsewhere [normal sigmas]
-  int slices = 0;         ///< the slices it was measured over
-  std::string reason;     ///< why there is no answer
+  /// slice-pair estimates it agrees with; or, last, the occupancy's best
+  /// place where a dense search's own best pose is clear of its next and the
+  /// same search with the maps' roles swapped finds it again.
+  enum class On { occupancy, corroborated, feature_votes, second_look } on = On::occupancy;
+  /// The answer's lead over the best candidate elsewhere; on a second look,
+  /// its search's best pose's over its next [normal sigmas].
+  double lead_sigma = 0;
+  int slices = 0;      ///< the slices it was measured over
+  std::string reason;  ///< why there is no answer
   /// Where two candidates' places were compared: the source raster's centre,
   /// in the source's frame [m].
   Eigen::Vector2d compared_at = Eigen::Vector2d::Zero();
@@ -35,6 +40,19 @@ struct CandidateVerdict {
   /// as the whole transform between the maps' own frames; unset where the
   /// finish did not run or did not hold.
   std::optional<Eigen::Matrix4d> finished;
+  /// The search whose second look would decide (SearchLead::look): look,
+  /// and ask again. Unset once the decision has what it needs.
+  std::optional<Candidate::From> needs_look;
+};
+
+/// What one dense search says of its own best pose, for the decision's last
+/// step: how far ahead of its next it is, and, where the decision asks for
+/// it, what the same search with the maps' roles swapped found.
+struct SearchLead {
+  Candidate::From from = Candidate::From::search_at_grid;
+  DenseEvidence found;  ///< its best pose, as it found it, and its next's score
+  int pooling = 1;      ///< the maps' slices per slice it searched: its height is that coarse
+  std::optional<SecondLook> look;
 };
 
 const char* onName(CandidateVerdict::On on);
@@ -50,8 +68,13 @@ const char* onName(CandidateVerdict::On on);
 /// at least one of the features' slice-pair estimates agrees with it; else
 /// the one the most slice-pair estimates agree with answers if it leads the
 /// most agreed-with elsewhere by kClearSigma, source slice by source slice,
-/// and no candidate elsewhere lands kClearSigma more.
+/// and no candidate elsewhere lands kClearSigma more; else the one that lands
+/// the most answers where the best pose of one of `searches` that answers
+/// alone in the verdict (at the grid, pooled) lies at its place, leads its
+/// next by kBars.dense_lead beyond chance over min_support slices, no
+/// search's best pose elsewhere leads its next so, and that search's second
+/// look finds it again (asked for by needs_look).
 CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, const MatchParams& params, double grid,
-                                    const Eigen::Vector2d& source_centre);
+                                    const Eigen::Vector2d& source_centre, const std::vector<SearchLead>& searches = {});
 
 }  // namespace tomomap

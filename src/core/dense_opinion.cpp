@@ -193,7 +193,25 @@ void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Propos
         proposals.push_back(
             {from, static_cast<int>(i), 0, (*o)->search.poses[i].transform, (*o)->search.poses[i].offset});
   r.candidates = refineAndLand(target, source, proposals, params, e.feature_votes);
-  r.candidate_verdict = decideOnCandidates(r.candidates, params, target.grid, source.occupancy.grid.centre());
+  // What each search says of its own best pose; the decision asks for a
+  // search's second look where that would decide.
+  std::vector<SearchLead> leads;
+  for (const auto& [o, from] :
+       {std::pair{&at_grid, Candidate::From::search_at_grid}, std::pair{&wide, Candidate::From::search_wide},
+        std::pair{&at_pooled, Candidate::From::search_pooled}})
+    if (*o && (*o)->found()) leads.push_back({from, evidenceOf(**o, r, false, target, source), (*o)->pooling, {}});
+  std::optional<SliceStack> ft, fs;
+  for (;;) {
+    r.candidate_verdict = decideOnCandidates(r.candidates, params, target.grid, source.occupancy.grid.centre(), leads);
+    if (!r.candidate_verdict->needs_look) break;
+    const Candidate::From which = *r.candidate_verdict->needs_look;
+    if (!ft) ft = fullSlices(target.occupancy), fs = fullSlices(source.occupancy);
+    for (SearchLead& l : leads)
+      if (l.from == which)
+        l.look = which == Candidate::From::search_pooled
+                     ? lookAgain(*at_pooled, target, source, pooled(*ft), pooled(*fs), params)
+                     : lookAgain(*at_grid, target, source, *ft, *fs, params);
+  }
 }
 
 /// `r` answered by the decision over the candidates (allCandidates): the

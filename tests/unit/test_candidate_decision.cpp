@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/candidate_decision.hpp"
+#include "core/height_offsets.hpp"
 #include "core/lead_sigma.hpp"
 
 using namespace tomomap;
@@ -177,4 +178,90 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   v = decideOnCandidates({from_features, along}, p, 0.1, Eigen::Vector2d::Zero());
   EXPECT_EQ(v.answer, -1);
   EXPECT_NE(v.reason.find("no dense search of the occupancy"), std::string::npos) << v.reason;
+}
+
+namespace {
+
+/// A dense search's word on its own best pose at (x, y, yaw): `best` telling
+/// cells landed over 6 slices, its next pose `next`.
+SearchLead searchLead(Candidate::From from, double x, double y, double yaw, size_t best, double next) {
+  SearchLead s;
+  s.from = from;
+  s.found.found = true;
+  s.found.best.transform = Rigid2D{yaw, Eigen::Vector2d(x, y)};
+  s.found.best.telling_inliers = best;
+  s.found.best.support = s.found.best.support_seen = 6;
+  s.found.next_score = next;
+  return s;
+}
+
+}  // namespace
+
+// A room at g 0.1: the right pose and a copy of it a wall along land alike
+// slice by slice, and no feature estimate tells them apart; the search of
+// the whole occupancy puts its own best pose at the right one, far ahead of
+// its next, and finds it again with the maps' roles swapped.
+TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereASearchsClearBestIsFoundAgainBothWays) {
+  const MatchParams p = atTenCentimetres();
+  const std::vector<Candidate> c{landing(0, 0, 0, 6, {62, 55, 70}), landing(0.6, 0, 0, 6, {60, 56, 66})};
+  std::vector<SearchLead> searches{searchLead(Candidate::From::search_at_grid, 0.05, 0, 0, 900, 300)};
+  CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), searches);
+  EXPECT_EQ(v.answer, -1);
+  ASSERT_TRUE(v.needs_look.has_value()) << "the look decides, so the decision asks for it: " << v.reason;
+  EXPECT_EQ(*v.needs_look, Candidate::From::search_at_grid);
+
+  searches[0].look = SecondLook{true, true, 0.02};
+  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), searches);
+  ASSERT_EQ(v.answer, 0) << v.reason;
+  EXPECT_EQ(v.on, CandidateVerdict::On::second_look);
+  EXPECT_FALSE(v.needs_look);
+  EXPECT_NEAR(v.lead_sigma, 600 / std::sqrt(1200.0), 1e-9) << "the search's lead over its next";
+
+  // Asked again the other way round, the search finds another place: no answer, and the reason says so.
+  searches[0].look = SecondLook{true, false, 2.4};
+  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), searches);
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_FALSE(v.needs_look);
+  EXPECT_NE(v.reason.find("search_at_grid with the maps' roles swapped found another place, 2.40 m apart"),
+            std::string::npos)
+      << v.reason;
+}
+
+TEST(CandidateDecision, ASearchsBestPoseNotClearOfItsNextOrClearlyElsewhereIsNoSecondLook) {
+  const MatchParams p = atTenCentimetres();
+  const std::vector<Candidate> c{landing(0, 0, 0, 6, {62, 55, 70}), landing(0.6, 0, 0, 6, {60, 56, 66})};
+  SearchLead grid = searchLead(Candidate::From::search_at_grid, 0, 0, 0, 900, 300);
+  grid.look = SecondLook{true, true, 0.0};
+
+  // 1.3x ahead of its next: not clear of it, however often it is found again.
+  SearchLead close = grid;
+  close.found.next_score = 900 / 1.3;
+  CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {close});
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_FALSE(v.needs_look);
+
+  // The wide search is not looked at again (it never answers alone), but
+  // its clear best pose elsewhere tells against the place: a real RGB-D
+  // crop's pooled best, found again both ways, was wrong where the grid's
+  // best lay elsewhere, 1.96x ahead.
+  const SearchLead wide_elsewhere = searchLead(Candidate::From::search_wide, 3, 1, 1.5, 500, 200);
+  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {grid, wide_elsewhere});
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_NE(v.reason.find("search_wide's best pose lies elsewhere, 2.50x ahead of its next"), std::string::npos)
+      << v.reason;
+  const SearchLead wide_here = searchLead(Candidate::From::search_wide, 0, 0, 0, 500, 200);
+  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {wide_here});
+  EXPECT_EQ(v.answer, -1) << "the wide search alone has no second look";
+  EXPECT_FALSE(v.needs_look);
+  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {wide_here, grid});
+  EXPECT_EQ(v.answer, 0) << v.reason;
+
+  // A pooled search's best pose is a whole number of pooled slices high: a
+  // slice above the place is still at it.
+  SearchLead pooled = grid;
+  pooled.from = Candidate::From::search_pooled;
+  pooled.pooling = 2;
+  pooled.found.best.offset = kSmearSlices / 2 + 1;
+  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {pooled});
+  EXPECT_EQ(v.answer, 0) << v.reason;
 }
