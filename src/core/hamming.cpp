@@ -5,7 +5,7 @@
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
-#define TOMOMAP_HAVE_AVX512_PATH 1
+#define TOMOMAP_HAVE_AVX512_PATH 1  // and the AVX2 one
 #endif
 
 namespace tomomap {
@@ -51,6 +51,24 @@ Nearest nearestScalar(const cv::Mat& a, const cv::Mat& b) {
 /// past the end of a repeat a's last row, whose keys change no minimum.
 constexpr int kIndexBits = 23;  ///< indices below 8 M; distances (at most 256) take the 9 bits above
 
+/// b's descriptors word-major in blocks of `lanes` descriptors: block k holds
+/// word 0 of descriptors k*lanes.. k*lanes+lanes-1, then word 1, and so on
+/// (eight 32-bit words a descriptor); the last block padded with zeros.
+std::vector<uint32_t> wordMajor(const cv::Mat& b, int lanes) {
+  constexpr int kWords = 8;
+  const int blocks = (b.rows + lanes - 1) / lanes;
+  std::vector<uint32_t> out(static_cast<size_t>(blocks) * static_cast<size_t>(lanes) * kWords, 0);
+  for (int j = 0; j < b.rows; ++j)
+    for (int w = 0; w < kWords; ++w)
+      std::memcpy(&out[static_cast<size_t>((j / lanes) * lanes * kWords + w * lanes + j % lanes)], b.ptr(j) + 4 * w, 4);
+  return out;
+}
+
+/// The nearest a descriptor of each b descriptor, read off its kept key.
+void keptIndices(const std::vector<uint32_t>& key_b, std::vector<int>& best_b) {
+  for (size_t j = 0; j < best_b.size(); ++j) best_b[j] = static_cast<int>(key_b[j] & ((1u << kIndexBits) - 1));
+}
+
 __attribute__((target("avx512f,avx512vpopcntdq"))) Nearest nearestAvx512(const cv::Mat& a, const cv::Mat& b) {
   constexpr int kLanes = 16, kRows = 4, kWords = 8;
   // Every lane, through the zero-masking forms: GCC 12's unmasked shift and min
@@ -58,11 +76,7 @@ __attribute__((target("avx512f,avx512vpopcntdq"))) Nearest nearestAvx512(const c
   constexpr __mmask16 kAll = 0xFFFF;
   CV_Assert(a.rows < (1 << kIndexBits) && b.rows < (1 << kIndexBits));
   const int na = a.rows, nb = b.rows, blocks = (nb + kLanes - 1) / kLanes;
-  std::vector<uint32_t> wb(static_cast<size_t>(blocks) * kLanes * kWords, 0);
-  for (int j = 0; j < nb; ++j)
-    for (int w = 0; w < kWords; ++w)
-      std::memcpy(&wb[static_cast<size_t>((j / kLanes) * kLanes * kWords + w * kLanes + j % kLanes)], b.ptr(j) + 4 * w,
-                  4);
+  const std::vector<uint32_t> wb = wordMajor(b, kLanes);
   std::vector<uint32_t> key_b(static_cast<size_t>(blocks) * kLanes, UINT32_MAX);
   Nearest n{std::vector<int>(static_cast<size_t>(na), -1), std::vector<int>(static_cast<size_t>(nb), -1)};
   const __mmask16 last_valid = static_cast<__mmask16>(nb % kLanes == 0 ? 0xFFFF : (1u << (nb % kLanes)) - 1);
@@ -108,13 +122,81 @@ __attribute__((target("avx512f,avx512vpopcntdq"))) Nearest nearestAvx512(const c
       n.best_a[static_cast<size_t>(i0 + r)] = static_cast<int>(m & ((1u << kIndexBits) - 1));
     }
   }
-  for (int j = 0; j < nb; ++j)
-    n.best_b[static_cast<size_t>(j)] = static_cast<int>(key_b[static_cast<size_t>(j)] & ((1u << kIndexBits) - 1));
+  keptIndices(key_b, n.best_b);
+  return n;
+}
+
+/// The same scan on AVX2, eight b descriptors against four a descriptors at a
+/// time, for CPUs without VPOPCNTDQ: each byte's bits counted by a sixteen-entry
+/// table of nibbles (VPSHUFB), summed over the eight words byte by byte (at
+/// most 64 a byte) and then over each lane's four bytes. The keys, the tie
+/// rule and the padding are nearestAvx512's.
+__attribute__((target("avx2"))) Nearest nearestAvx2(const cv::Mat& a, const cv::Mat& b) {
+  constexpr int kLanes = 8, kRows = 4, kWords = 8;
+  CV_Assert(a.rows < (1 << kIndexBits) && b.rows < (1 << kIndexBits));
+  const int na = a.rows, nb = b.rows, blocks = (nb + kLanes - 1) / kLanes;
+  const std::vector<uint32_t> wb = wordMajor(b, kLanes);
+  std::vector<uint32_t> key_b(static_cast<size_t>(blocks) * kLanes, UINT32_MAX);
+  Nearest n{std::vector<int>(static_cast<size_t>(na), -1), std::vector<int>(static_cast<size_t>(nb), -1)};
+  const __m256i none = _mm256_set1_epi32(-1), lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
+                nibble = _mm256_set1_epi8(0x0F), ones8 = _mm256_set1_epi8(1), ones16 = _mm256_set1_epi16(1),
+                bits = _mm256_setr_epi8(0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4, 0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2,
+                                        3, 2, 3, 3, 4);
+  // Lanes past the end of b: all ones, so that their keys are the largest.
+  const __m256i past_end =
+      _mm256_cmpgt_epi32(_mm256_add_epi32(lane, _mm256_set1_epi32((blocks - 1) * kLanes + 1)), _mm256_set1_epi32(nb));
+  for (int i0 = 0; i0 < na; i0 += kRows) {
+    uint32_t x[kRows][kWords];
+    __m256i row_index[kRows], best[kRows];
+#pragma GCC unroll 4
+    for (int r = 0; r < kRows; ++r) {
+      const int i = std::min(i0 + r, na - 1);
+      std::memcpy(x[r], a.ptr(i), sizeof x[r]);
+      row_index[r] = _mm256_set1_epi32(i);
+      best[r] = none;
+    }
+    for (int k = 0; k < blocks; ++k) {
+      const uint32_t* y = &wb[static_cast<size_t>(k) * kLanes * kWords];
+      __m256i yw[kWords];
+#pragma GCC unroll 8
+      for (int w = 0; w < kWords; ++w) yw[w] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(y + w * kLanes));
+      const __m256i j = _mm256_add_epi32(_mm256_set1_epi32(kLanes * k), lane);
+      const __m256i pad = k == blocks - 1 ? past_end : _mm256_setzero_si256();
+      uint32_t* kb = &key_b[static_cast<size_t>(k) * kLanes];
+      __m256i nearest_b = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(kb));
+#pragma GCC unroll 4
+      for (int r = 0; r < kRows; ++r) {
+        __m256i bytes = _mm256_setzero_si256();
+#pragma GCC unroll 8
+        for (int w = 0; w < kWords; ++w) {
+          const __m256i v = _mm256_xor_si256(yw[w], _mm256_set1_epi32(static_cast<int>(x[r][w])));
+          bytes = _mm256_add_epi8(bytes, _mm256_shuffle_epi8(bits, _mm256_and_si256(v, nibble)));
+          bytes = _mm256_add_epi8(bytes, _mm256_shuffle_epi8(bits, _mm256_and_si256(_mm256_srli_epi16(v, 4), nibble)));
+        }
+        const __m256i d = _mm256_slli_epi32(_mm256_madd_epi16(_mm256_maddubs_epi16(bytes, ones8), ones16), kIndexBits);
+        best[r] = _mm256_min_epu32(best[r], _mm256_or_si256(_mm256_or_si256(d, j), pad));
+        nearest_b = _mm256_min_epu32(nearest_b, _mm256_or_si256(d, row_index[r]));
+      }
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(kb), nearest_b);
+    }
+    for (int r = 0; r < kRows && i0 + r < na; ++r) {
+      alignas(32) uint32_t keys[kLanes];
+      _mm256_store_si256(reinterpret_cast<__m256i*>(keys), best[r]);
+      const uint32_t m = *std::min_element(keys, keys + kLanes);
+      n.best_a[static_cast<size_t>(i0 + r)] = static_cast<int>(m & ((1u << kIndexBits) - 1));
+    }
+  }
+  keptIndices(key_b, n.best_b);
   return n;
 }
 
 bool haveAvx512Popcount() {
   static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vpopcntdq");
+  return yes;
+}
+
+bool haveAvx2() {
+  static const bool yes = __builtin_cpu_supports("avx2");
   return yes;
 }
 #endif
@@ -127,31 +209,46 @@ std::vector<uint64_t> descriptorWords(const cv::Mat& m) {
   return w;
 }
 
+bool hammingKernelRuns(HammingKernel kernel) {
+#ifdef TOMOMAP_HAVE_AVX512_PATH
+  switch (kernel) {
+    case HammingKernel::Avx512:
+      return haveAvx512Popcount();
+    case HammingKernel::Avx2:
+      return haveAvx2();
+    case HammingKernel::Fastest:
+    case HammingKernel::Scalar:
+      return true;
+  }
+  return false;
+#else
+  return kernel == HammingKernel::Fastest || kernel == HammingKernel::Scalar;
+#endif
+}
+
 std::vector<std::pair<int, int>> mutualNearest(const cv::Mat& a, const cv::Mat& b, HammingKernel kernel) {
   CV_Assert(a.empty() || (a.type() == CV_8U && a.cols == 32));
   CV_Assert(b.empty() || (b.type() == CV_8U && b.cols == 32));
+  CV_Assert(hammingKernelRuns(kernel));
   std::vector<std::pair<int, int>> out;
   if (a.rows == 0 || b.rows == 0) return out;
+  if (kernel == HammingKernel::Fastest)
+    for (const HammingKernel k : {HammingKernel::Avx512, HammingKernel::Avx2, HammingKernel::Scalar})
+      if (hammingKernelRuns(k)) {
+        kernel = k;
+        break;
+      }
+  Nearest n;
 #ifdef TOMOMAP_HAVE_AVX512_PATH
-  const Nearest n =
-      kernel == HammingKernel::Fastest && haveAvx512Popcount() ? nearestAvx512(a, b) : nearestScalar(a, b);
-#else
-  (void)kernel;
-  const Nearest n = nearestScalar(a, b);
+  if (kernel == HammingKernel::Avx512) n = nearestAvx512(a, b);
+  if (kernel == HammingKernel::Avx2) n = nearestAvx2(a, b);
 #endif
+  if (kernel == HammingKernel::Scalar) n = nearestScalar(a, b);
   for (int i = 0; i < a.rows; ++i) {
     const int j = n.best_a[static_cast<size_t>(i)];
     if (n.best_b[static_cast<size_t>(j)] == i) out.emplace_back(i, j);
   }
   return out;
-}
-
-bool vectorHammingAvailable() {
-#ifdef TOMOMAP_HAVE_AVX512_PATH
-  return haveAvx512Popcount();
-#else
-  return false;
-#endif
 }
 
 }  // namespace tomomap

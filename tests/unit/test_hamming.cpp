@@ -40,19 +40,29 @@ TEST(Hamming, EmptySetsGiveNoMatches) {
   EXPECT_TRUE(mutualNearest(cv::Mat(), a).empty());
 }
 
-TEST(Hamming, TheVectorKernelGivesTheScalarKernelsMatchesTiesIncluded) {
-  if (!vectorHammingAvailable()) GTEST_SKIP() << "this CPU has no AVX-512 VPOPCNTDQ: only the scalar kernel runs";
+TEST(Hamming, EachVectorKernelGivesTheScalarKernelsMatchesTiesIncluded) {
+  std::vector<HammingKernel> kernels;
+  for (const HammingKernel k : {HammingKernel::Avx512, HammingKernel::Avx2})
+    if (hammingKernelRuns(k)) kernels.push_back(k);
+  if (kernels.empty()) GTEST_SKIP() << "this CPU has neither AVX-512 VPOPCNTDQ nor AVX2: only the scalar kernel runs";
   cv::RNG rng(11);
   // Few distinct bytes make many equal distances, so the tie rules are exercised;
-  // sizes that are not multiples of the kernel's 16 lanes or 4 rows exercise
-  // the last, partial block and the last rows.
-  for (const auto& [na, nb, values] :
-       {std::tuple{1, 1, 256}, std::tuple{37, 13, 2}, std::tuple{64, 64, 3}, std::tuple{500, 999, 256},
-        std::tuple{9, 300, 4}, std::tuple{3, 16, 2}, std::tuple{6, 17, 2}, std::tuple{1000, 1000, 256}}) {
-    cv::Mat a(na, 32, CV_8U), b(nb, 32, CV_8U);
-    rng.fill(a, cv::RNG::UNIFORM, 0, values);
-    rng.fill(b, cv::RNG::UNIFORM, 0, values);
-    EXPECT_EQ(mutualNearest(a, b, HammingKernel::Fastest), mutualNearest(a, b, HammingKernel::Scalar))
-        << na << " x " << nb << ", bytes below " << values;
-  }
+  // sizes that are not multiples of the kernels' 16 or 8 lanes or 4 rows
+  // exercise the last, partial block and the last rows.
+  for (const HammingKernel kernel : kernels)
+    for (const auto& [na, nb, values] :
+         {std::tuple{1, 1, 256}, std::tuple{37, 13, 2}, std::tuple{64, 64, 3}, std::tuple{500, 999, 256},
+          std::tuple{9, 300, 4}, std::tuple{3, 16, 2}, std::tuple{6, 17, 2}, std::tuple{5, 7, 2}, std::tuple{2, 9, 3},
+          std::tuple{1000, 1000, 256}}) {
+      cv::Mat a(na, 32, CV_8U), b(nb, 32, CV_8U);
+      rng.fill(a, cv::RNG::UNIFORM, 0, values);
+      rng.fill(b, cv::RNG::UNIFORM, 0, values);
+      EXPECT_EQ(mutualNearest(a, b, kernel), mutualNearest(a, b, HammingKernel::Scalar))
+          << (kernel == HammingKernel::Avx512 ? "AVX-512 " : "AVX2 ") << na << " x " << nb << ", bytes below "
+          << values;
+    }
+  // All bits apart: the largest distance, 256, whose count fills each byte's sum.
+  cv::Mat zeros(3, 32, CV_8U, cv::Scalar(0)), ones(11, 32, CV_8U, cv::Scalar(255));
+  for (const HammingKernel kernel : kernels)
+    EXPECT_EQ(mutualNearest(zeros, ones, kernel), mutualNearest(zeros, ones, HammingKernel::Scalar));
 }
