@@ -12,8 +12,10 @@
 
 namespace tomomap {
 
-/// The one bar: a lead counts when chance alone would give it less often than
-/// a normal variable exceeds this many standard deviations (one-sided, 0.13 %).
+/// The decision's own bar (its second look reads the dense searches' leads
+/// by the verdict's, kBars): a lead counts when chance alone would give it
+/// less often than a normal variable exceeds this many standard deviations
+/// (one-sided, 0.13 %).
 /// On the matrix's 316 pairs no answer was wrong from 3 (docs/results.md,
 /// "Candidates on the matrix"); it is not tuned below that.
 inline constexpr double kClearSigma = 3.0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <tuple>
 
 #include "dense_refine.hpp"
 #include "dense_search.hpp"
@@ -171,46 +172,48 @@ void allCandidates(MatchResult& r, const Evidence& e, const std::optional<Propos
   std::vector<Proposal> proposals;
   if (feature) proposals.push_back(*feature);
   for (const Proposal& p : e.feature_rivals) proposals.push_back(p);
+  // The maps' full slices, made where a search or a look needs them.
+  std::optional<SliceStack> ft, fs;
+  const auto full = [&] {
+    if (!ft) ft = fullSlices(target.occupancy), fs = fullSlices(source.occupancy);
+  };
   // Each search where it reaches (the wide one, on its finer coarse raster,
   // reaches maps twice as large: LiDAR crops).
   if (denseSearchable(target.occupancy) && denseSearchable(source.occupancy)) {
-    const SliceStack ft = fullSlices(target.occupancy), fs = fullSlices(source.occupancy);
-    if (!at_grid) at_grid = searchAt(target, source, ft, fs, 1, params);
+    if (!at_grid) full(), at_grid = searchAt(target, source, *ft, *fs, 1, params);
     if (!at_pooled && 2 * target.grid <= kBars.coarsest_pooled_cell + 1e-9)
-      at_pooled = searchAt(target, source, pooled(ft), pooled(fs), 2, params);
+      full(), at_pooled = searchAt(target, source, pooled(*ft), pooled(*fs), 2, params);
   }
   if (!wide && denseSearchable(target.occupancy, wideSearch()) && denseSearchable(source.occupancy, wideSearch()))
     wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch());
-  // Each search's lead, as the verdict's path records it, for the searches it did not ask for.
-  for (const auto& [o, lead] : {std::pair{&at_grid, &r.dense.at_grid_lead}, std::pair{&wide, &r.dense.wide_lead},
-                                std::pair{&at_pooled, &r.dense.pooled_lead}})
-    if (*o && (*o)->found() && *lead == 0) *lead = evidenceOf(**o, r, false, target, source).lead();
-  for (const auto& [o, from] :
-       {std::pair{&at_grid, Candidate::From::search_at_grid}, std::pair{&wide, Candidate::From::search_wide},
-        std::pair{&at_pooled, Candidate::From::search_pooled}})
-    if (*o)
-      for (size_t i = 0; i < (*o)->search.poses.size() && i < kProposalsPerSearch; ++i)
-        proposals.push_back(
-            {from, static_cast<int>(i), 0, (*o)->search.poses[i].transform, (*o)->search.poses[i].offset});
-  r.candidates = refineAndLand(target, source, proposals, params, e.feature_votes);
-  // What each search says of its own best pose; the decision asks for a
-  // search's second look where that would decide.
+  // Each search's poses proposed; what it says of its own best pose, for the
+  // decision; its lead, as the verdict's path records it, where it did not ask for it.
   std::vector<SearchLead> leads;
-  for (const auto& [o, from] :
-       {std::pair{&at_grid, Candidate::From::search_at_grid}, std::pair{&wide, Candidate::From::search_wide},
-        std::pair{&at_pooled, Candidate::From::search_pooled}})
-    if (*o && (*o)->found()) leads.push_back({from, evidenceOf(**o, r, false, target, source), (*o)->pooling, {}});
-  std::optional<SliceStack> ft, fs;
+  for (const auto& [o, from, lead] : {std::tuple{&at_grid, Candidate::From::search_at_grid, &r.dense.at_grid_lead},
+                                      std::tuple{&wide, Candidate::From::search_wide, &r.dense.wide_lead},
+                                      std::tuple{&at_pooled, Candidate::From::search_pooled, &r.dense.pooled_lead}}) {
+    if (!*o) continue;
+    for (size_t i = 0; i < (*o)->search.poses.size() && i < kProposalsPerSearch; ++i)
+      proposals.push_back(
+          {from, static_cast<int>(i), 0, (*o)->search.poses[i].transform, (*o)->search.poses[i].offset});
+    if (!(*o)->found()) continue;
+    leads.push_back({from, evidenceOf(**o, r, false, target, source), (*o)->pooling, {}});
+    if (*lead == 0) *lead = leads.back().found.lead();
+  }
+  r.candidates = refineAndLand(target, source, proposals, params, e.feature_votes);
+  // The decision asks for a search's second look where that would decide.
   for (;;) {
     r.candidate_verdict = decideOnCandidates(r.candidates, params, target.grid, source.occupancy.grid.centre(), leads);
     if (!r.candidate_verdict->needs_look) break;
     const Candidate::From which = *r.candidate_verdict->needs_look;
-    if (!ft) ft = fullSlices(target.occupancy), fs = fullSlices(source.occupancy);
+    full();
     for (SearchLead& l : leads)
-      if (l.from == which)
+      if (l.from == which) {
         l.look = which == Candidate::From::search_pooled
                      ? lookAgain(*at_pooled, target, source, pooled(*ft), pooled(*fs), params)
                      : lookAgain(*at_grid, target, source, *ft, *fs, params);
+        if (l.look->found && !r.dense.second_look_apart) r.dense.second_look_apart = l.look->apart;
+      }
   }
 }
 

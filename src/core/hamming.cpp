@@ -5,7 +5,7 @@
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
-#define TOMOMAP_HAVE_AVX512_PATH 1  // and the AVX2 one
+#define TOMOMAP_HAVE_X86_KERNELS 1  ///< the AVX-512 and AVX2 kernels, chosen at run time
 #endif
 
 namespace tomomap {
@@ -40,15 +40,13 @@ Nearest nearestScalar(const cv::Mat& a, const cv::Mat& b) {
   return n;
 }
 
-#ifdef TOMOMAP_HAVE_AVX512_PATH
-/// The same scan, sixteen b descriptors against four a descriptors at a time
-/// (AVX-512 with VPOPCNTDQ). b is laid out word-major in blocks of sixteen
-/// 32-bit lanes, so one load brings the same word of sixteen descriptors and
-/// serves four rows of a. Each distance travels with its index as one key,
-/// distance << kIndexBits | index: the smallest key is the nearest neighbour
-/// with the lowest index, the scalar scan's tie rule both ways, and one
-/// unsigned min keeps it. Lanes past the end of b hold the largest key; rows
-/// past the end of a repeat a's last row, whose keys change no minimum.
+#ifdef TOMOMAP_HAVE_X86_KERNELS
+/// The vector kernels' keys: each distance travels with its index as one
+/// key, distance << kIndexBits | index, so that the smallest key is the
+/// nearest neighbour with the lowest index, the scalar scan's tie rule both
+/// ways, and one unsigned min keeps it (a distance of 256 sets the key's top
+/// bit). Lanes past the end of b hold the largest key; rows past the end of
+/// a repeat a's last row, whose keys change no minimum.
 constexpr int kIndexBits = 23;  ///< indices below 8 M; distances (at most 256) take the 9 bits above
 
 /// b's descriptors word-major in blocks of `lanes` descriptors: block k holds
@@ -69,6 +67,10 @@ void keptIndices(const std::vector<uint32_t>& key_b, std::vector<int>& best_b) {
   for (size_t j = 0; j < best_b.size(); ++j) best_b[j] = static_cast<int>(key_b[j] & ((1u << kIndexBits) - 1));
 }
 
+/// The same scan, sixteen b descriptors against four a descriptors at a time
+/// (AVX-512 with VPOPCNTDQ). b is laid out word-major in blocks of sixteen
+/// 32-bit lanes (wordMajor), so one load brings the same word of sixteen
+/// descriptors and serves four rows of a.
 __attribute__((target("avx512f,avx512vpopcntdq"))) Nearest nearestAvx512(const cv::Mat& a, const cv::Mat& b) {
   constexpr int kLanes = 16, kRows = 4, kWords = 8;
   // Every lane, through the zero-masking forms: GCC 12's unmasked shift and min
@@ -210,7 +212,7 @@ std::vector<uint64_t> descriptorWords(const cv::Mat& m) {
 }
 
 bool hammingKernelRuns(HammingKernel kernel) {
-#ifdef TOMOMAP_HAVE_AVX512_PATH
+#ifdef TOMOMAP_HAVE_X86_KERNELS
   switch (kernel) {
     case HammingKernel::Avx512:
       return haveAvx512Popcount();
@@ -238,12 +240,23 @@ std::vector<std::pair<int, int>> mutualNearest(const cv::Mat& a, const cv::Mat& 
         kernel = k;
         break;
       }
-  Nearest n;
-#ifdef TOMOMAP_HAVE_AVX512_PATH
-  if (kernel == HammingKernel::Avx512) n = nearestAvx512(a, b);
-  if (kernel == HammingKernel::Avx2) n = nearestAvx2(a, b);
+  const Nearest n = [&] {
+    switch (kernel) {
+#ifdef TOMOMAP_HAVE_X86_KERNELS
+      case HammingKernel::Avx512:
+        return nearestAvx512(a, b);
+      case HammingKernel::Avx2:
+        return nearestAvx2(a, b);
+#else
+      case HammingKernel::Avx512:
+      case HammingKernel::Avx2:
 #endif
-  if (kernel == HammingKernel::Scalar) n = nearestScalar(a, b);
+      case HammingKernel::Fastest:  // resolved above
+      case HammingKernel::Scalar:
+        break;
+    }
+    return nearestScalar(a, b);
+  }();
   for (int i = 0; i < a.rows; ++i) {
     const int j = n.best_a[static_cast<size_t>(i)];
     if (n.best_b[static_cast<size_t>(j)] == i) out.emplace_back(i, j);

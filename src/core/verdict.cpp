@@ -37,19 +37,21 @@ bool aheadBeyondChance(double score, double other, double by) {
   return leadOver(score, other) >= by && significance(score, other) >= kBars.significant;
 }
 
-/// Whether a search found a best pose that leads its next by `by`, beyond chance.
+}  // namespace
+
 bool aheadBeyondChance(const DenseEvidence& d, double by) {
   return d.found && aheadBeyondChance(d.best.score(), d.next_score, by);
 }
 
-/// Whether a pose holds over `slices` of the slices that land where the other
-/// map saw anything (support_seen: crops share 20-60 %).
-bool holdsWhereSeen(const DensePose& p, int slices) { return consistent(p) && p.support_seen >= slices; }
-
-/// Whether a search's best pose leads by `by`, beyond chance, and holds.
 bool leads(const DenseEvidence& d, double by, const MatchParams& params) {
   return aheadBeyondChance(d, by) && holdsOver(d.best, params.min_support);
 }
+
+namespace {
+
+/// Whether a pose holds over `slices` of the slices that land where the other
+/// map saw anything (support_seen: crops share 20-60 %).
+bool holdsWhereSeen(const DensePose& p, int slices) { return consistent(p) && p.support_seen >= slices; }
 
 /// A feature answer on too little evidence to stand alone: too few slice
 /// pairs, a runner-up within reach, or too few inliers. An ambiguous winner

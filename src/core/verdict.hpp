@@ -134,6 +134,12 @@ struct DenseEvidence {
   double lead() const;
 };
 
+/// Whether a search found a best pose that leads its next by `by`, beyond
+/// chance (kBars.significant).
+bool aheadBeyondChance(const DenseEvidence& d, double by);
+/// The same, its best pose holding over min_support slices (holdsOver).
+bool leads(const DenseEvidence& d, double by, const MatchParams& params);
+
 /// The search whose best pose would answer, asked again with the maps' roles
 /// swapped (the target's cells landed on the source's raster): a second look
 /// at the same occupancy, its best pose turned back to map the source onto

@@ -225,9 +225,23 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereASearchsClearBestIsFou
   EXPECT_NE(v.reason.find("search_at_grid with the maps' roles swapped found another place, 2.40 m apart"),
             std::string::npos)
       << v.reason;
+
+  // The pooled search's best pose is there too: where the grid's look fails, the decision asks for the pooled one's.
+  SearchLead pooled = searches[0];
+  pooled.from = Candidate::From::search_pooled;
+  pooled.pooling = 2;
+  pooled.look.reset();
+  searches.push_back(pooled);
+  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), searches);
+  ASSERT_TRUE(v.needs_look.has_value()) << v.reason;
+  EXPECT_EQ(*v.needs_look, Candidate::From::search_pooled);
+  searches[1].look = SecondLook{false, false, 0.0};
+  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), searches);
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_NE(v.reason.find("search_pooled with the maps' roles swapped found no pose"), std::string::npos) << v.reason;
 }
 
-TEST(CandidateDecision, ASearchsBestPoseNotClearOfItsNextOrClearlyElsewhereIsNoSecondLook) {
+TEST(CandidateDecision, ASearchsBestPoseNotClearOfItsNextOrClearlyElsewhereDoesNotAnswer) {
   const MatchParams p = atTenCentimetres();
   const std::vector<Candidate> c{landing(0, 0, 0, 6, {62, 55, 70}), landing(0.6, 0, 0, 6, {60, 56, 66})};
   SearchLead grid = searchLead(Candidate::From::search_at_grid, 0, 0, 0, 900, 300);
@@ -237,6 +251,12 @@ TEST(CandidateDecision, ASearchsBestPoseNotClearOfItsNextOrClearlyElsewhereIsNoS
   SearchLead close = grid;
   close.found.next_score = 900 / 1.3;
   CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {close});
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_FALSE(v.needs_look);
+  // Clear, but on fewer slices than min_support: a floor alone.
+  SearchLead thin = grid;
+  thin.found.best.support = p.min_support - 1;
+  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {thin});
   EXPECT_EQ(v.answer, -1);
   EXPECT_FALSE(v.needs_look);
 

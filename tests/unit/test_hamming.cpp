@@ -61,8 +61,12 @@ TEST(Hamming, EachVectorKernelGivesTheScalarKernelsMatchesTiesIncluded) {
           << (kernel == HammingKernel::Avx512 ? "AVX-512 " : "AVX2 ") << na << " x " << nb << ", bytes below "
           << values;
     }
-  // All bits apart: the largest distance, 256, whose count fills each byte's sum.
-  cv::Mat zeros(3, 32, CV_8U, cv::Scalar(0)), ones(11, 32, CV_8U, cv::Scalar(255));
+  // The largest distance, 256 (all bits apart), sets a key's top bit: a
+  // signed minimum would rank it nearest. Rows at 256 come first, so that
+  // the lower index does not hide it; the row at 255 is the nearest.
+  cv::Mat zeros(3, 32, CV_8U, cv::Scalar(0)), far(11, 32, CV_8U, cv::Scalar(255));
+  far.at<uint8_t>(9, 31) = 0x7F;
   for (const HammingKernel kernel : kernels)
-    EXPECT_EQ(mutualNearest(zeros, ones, kernel), mutualNearest(zeros, ones, HammingKernel::Scalar));
+    EXPECT_EQ(mutualNearest(zeros, far, kernel), (std::vector<std::pair<int, int>>{{0, 9}}));
+  EXPECT_EQ(mutualNearest(zeros, far, HammingKernel::Scalar), (std::vector<std::pair<int, int>>{{0, 9}}));
 }
