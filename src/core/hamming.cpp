@@ -14,13 +14,14 @@ namespace {
 /// Nearest neighbours both ways: best_a[i] is the first j nearest a_i,
 /// best_b[j] the first i nearest b_j.
 struct Nearest {
+  Nearest(int na, int nb) : best_a(static_cast<size_t>(na), -1), best_b(static_cast<size_t>(nb), -1) {}
   std::vector<int> best_a, best_b;
 };
 
 Nearest nearestScalar(const cv::Mat& a, const cv::Mat& b) {
   const int na = a.rows, nb = b.rows;
   const std::vector<uint64_t> wa = descriptorWords(a), wb = descriptorWords(b);
-  Nearest n{std::vector<int>(static_cast<size_t>(na), -1), std::vector<int>(static_cast<size_t>(nb), -1)};
+  Nearest n(na, nb);
   std::vector<uint32_t> dist_b(static_cast<size_t>(nb), UINT32_MAX);
   for (int i = 0; i < na; ++i) {
     const uint64_t* x = &wa[static_cast<size_t>(i) * 4];
@@ -62,9 +63,16 @@ std::vector<uint32_t> wordMajor(const cv::Mat& b, int lanes) {
   return out;
 }
 
+/// The index a key carries.
+int keyIndex(uint32_t key) { return static_cast<int>(key & ((1u << kIndexBits) - 1)); }
+
+/// The index of the smallest of `lanes` keys: a row's nearest neighbour,
+/// from the keys its lanes kept.
+int nearestIndex(const uint32_t* keys, int lanes) { return keyIndex(*std::min_element(keys, keys + lanes)); }
+
 /// The nearest a descriptor of each b descriptor, read off its kept key.
 void keptIndices(const std::vector<uint32_t>& key_b, std::vector<int>& best_b) {
-  for (size_t j = 0; j < best_b.size(); ++j) best_b[j] = static_cast<int>(key_b[j] & ((1u << kIndexBits) - 1));
+  for (size_t j = 0; j < best_b.size(); ++j) best_b[j] = keyIndex(key_b[j]);
 }
 
 /// The same scan, sixteen b descriptors against four a descriptors at a time
@@ -80,7 +88,7 @@ __attribute__((target("avx512f,avx512vpopcntdq"))) Nearest nearestAvx512(const c
   const int na = a.rows, nb = b.rows, blocks = (nb + kLanes - 1) / kLanes;
   const std::vector<uint32_t> wb = wordMajor(b, kLanes);
   std::vector<uint32_t> key_b(static_cast<size_t>(blocks) * kLanes, UINT32_MAX);
-  Nearest n{std::vector<int>(static_cast<size_t>(na), -1), std::vector<int>(static_cast<size_t>(nb), -1)};
+  Nearest n(na, nb);
   const __mmask16 last_valid = static_cast<__mmask16>(nb % kLanes == 0 ? 0xFFFF : (1u << (nb % kLanes)) - 1);
   const __m512i none = _mm512_set1_epi32(-1),
                 lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -120,8 +128,7 @@ __attribute__((target("avx512f,avx512vpopcntdq"))) Nearest nearestAvx512(const c
       // Sixteen lanes reduced by hand (GCC 12's reduce intrinsics warn of an uninitialised temporary).
       alignas(64) uint32_t keys[kLanes];
       _mm512_store_si512(keys, best[r]);
-      const uint32_t m = *std::min_element(keys, keys + kLanes);
-      n.best_a[static_cast<size_t>(i0 + r)] = static_cast<int>(m & ((1u << kIndexBits) - 1));
+      n.best_a[static_cast<size_t>(i0 + r)] = nearestIndex(keys, kLanes);
     }
   }
   keptIndices(key_b, n.best_b);
@@ -139,7 +146,7 @@ __attribute__((target("avx2"))) Nearest nearestAvx2(const cv::Mat& a, const cv::
   const int na = a.rows, nb = b.rows, blocks = (nb + kLanes - 1) / kLanes;
   const std::vector<uint32_t> wb = wordMajor(b, kLanes);
   std::vector<uint32_t> key_b(static_cast<size_t>(blocks) * kLanes, UINT32_MAX);
-  Nearest n{std::vector<int>(static_cast<size_t>(na), -1), std::vector<int>(static_cast<size_t>(nb), -1)};
+  Nearest n(na, nb);
   const __m256i none = _mm256_set1_epi32(-1), lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
                 nibble = _mm256_set1_epi8(0x0F), ones8 = _mm256_set1_epi8(1), ones16 = _mm256_set1_epi16(1),
                 bits = _mm256_setr_epi8(0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4, 0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2,
@@ -184,8 +191,7 @@ __attribute__((target("avx2"))) Nearest nearestAvx2(const cv::Mat& a, const cv::
     for (int r = 0; r < kRows && i0 + r < na; ++r) {
       alignas(32) uint32_t keys[kLanes];
       _mm256_store_si256(reinterpret_cast<__m256i*>(keys), best[r]);
-      const uint32_t m = *std::min_element(keys, keys + kLanes);
-      n.best_a[static_cast<size_t>(i0 + r)] = static_cast<int>(m & ((1u << kIndexBits) - 1));
+      n.best_a[static_cast<size_t>(i0 + r)] = nearestIndex(keys, kLanes);
     }
   }
   keptIndices(key_b, n.best_b);
