@@ -66,8 +66,9 @@ const char* onName(CandidateVerdict::On on);
 /// cells less twice the contradicted ones, slice by slice, on occupancy pooled
 /// to DenseSearchParams::finest_empty_cell where the grid is finer) answers if
 /// it leads the best candidate elsewhere by kClearSigma over the slices; else
-/// it answers as well where a dense search's best pose lies at its place and
-/// at least one of the features' slice-pair estimates agrees with it; else
+/// it answers as well where a dense search's best pose lies at its place,
+/// ahead of its next beyond chance (`searches`), and at least one of the
+/// features' slice-pair estimates agrees with it; else
 /// the one the most slice-pair estimates agree with answers if it leads the
 /// most agreed-with elsewhere by kClearSigma, source slice by source slice,
 /// and no candidate elsewhere lands kClearSigma more; else the one that lands

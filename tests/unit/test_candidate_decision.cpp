@@ -141,45 +141,6 @@ TEST(CandidateDecision, EmptySpaceTheOtherMapSawCountsAgainstAPose) {
   EXPECT_EQ(v.answer, 1) << v.reason;
 }
 
-TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatureEstimateFindItToo) {
-  const MatchParams p = atTenCentimetres();
-  // An RGB-D crop: the right pose and a copy of it 0.6 m along a wall land
-  // almost alike over few slices, not clear of each other.
-  Candidate right = landing(0, 0, 0, 6, {62, 55, 70}), along = landing(0.6, 0, 0, 6, {60, 56, 66});
-  right.from = Candidate::From::search_wide;
-  along.from = Candidate::From::search_pooled;
-  right.feature_votes = {0, 1, 0};
-  CandidateVerdict v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero());
-  ASSERT_EQ(v.answer, 0) << v.reason;
-  EXPECT_EQ(v.on, CandidateVerdict::On::corroborated);
-  EXPECT_LT(v.lead_sigma, kClearSigma) << "the occupancy alone does not tell them apart";
-
-  // No slice-pair estimate there: the occupancy's word alone, which is not clear.
-  Candidate unvoted = right;
-  unvoted.feature_votes.clear();
-  v = decideOnCandidates({unvoted, along}, p, 0.1, Eigen::Vector2d::Zero());
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("no slice-pair estimate of the features agrees"), std::string::npos) << v.reason;
-
-  // The dense search's own best is the copy along the wall (rank 0), this is
-  // its runner-up: the two looks at the occupancy disagree.
-  Candidate runner_up = right;
-  runner_up.rank = 1;
-  along.rank = 0;
-  v = decideOnCandidates({runner_up, along}, p, 0.1, Eigen::Vector2d::Zero());
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("no dense search's best pose is at its place"), std::string::npos) << v.reason;
-
-  // The features' own answer is not a dense search: it corroborates nothing by itself.
-  Candidate from_features = right;
-  from_features.from = Candidate::From::features;
-  along.rank = 1;
-  along.from = Candidate::From::feature_rival;
-  v = decideOnCandidates({from_features, along}, p, 0.1, Eigen::Vector2d::Zero());
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("no dense search of the occupancy"), std::string::npos) << v.reason;
-}
-
 namespace {
 
 /// A dense search's word on its own best pose at (x, y, yaw): `best` telling
@@ -196,6 +157,56 @@ SearchLead searchLead(Candidate::From from, double x, double y, double yaw, size
 }
 
 }  // namespace
+
+TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatureEstimateFindItToo) {
+  const MatchParams p = atTenCentimetres();
+  // An RGB-D crop: the right pose and a copy of it 0.6 m along a wall land
+  // almost alike over few slices, not clear of each other.
+  Candidate right = landing(0, 0, 0, 6, {62, 55, 70}), along = landing(0.6, 0, 0, 6, {60, 56, 66});
+  right.from = Candidate::From::search_wide;
+  along.from = Candidate::From::search_pooled;
+  right.feature_votes = {0, 1, 0};
+  // The wide search's own best pose, 1.5x its next: beyond chance (6.3 sigma).
+  const std::vector<SearchLead> wide{searchLead(Candidate::From::search_wide, 0, 0, 0, 600, 400)};
+  CandidateVerdict v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
+  ASSERT_EQ(v.answer, 0) << v.reason;
+  EXPECT_EQ(v.on, CandidateVerdict::On::corroborated);
+  EXPECT_LT(v.lead_sigma, kClearSigma) << "the occupancy alone does not tell them apart";
+
+  // The search's best pose within chance of its next (1.04x, 0.7 sigma) ranks nothing.
+  std::vector<SearchLead> close = wide;
+  close[0].found.next_score = 600 / 1.04;
+  v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero(), close);
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_NE(v.reason.find("no dense search's best pose clear of its next is at its place"), std::string::npos)
+      << v.reason;
+
+  // No slice-pair estimate there: the occupancy's word alone, which is not clear.
+  Candidate unvoted = right;
+  unvoted.feature_votes.clear();
+  v = decideOnCandidates({unvoted, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_NE(v.reason.find("no slice-pair estimate of the features agrees"), std::string::npos) << v.reason;
+
+  // The dense search's own best is the copy along the wall (rank 0), this is
+  // its runner-up: the two looks at the occupancy disagree.
+  Candidate runner_up = right;
+  runner_up.rank = 1;
+  along.rank = 0;
+  v = decideOnCandidates({runner_up, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_NE(v.reason.find("no dense search's best pose clear of its next is at its place"), std::string::npos)
+      << v.reason;
+
+  // The features' own answer is not a dense search: it corroborates nothing by itself.
+  Candidate from_features = right;
+  from_features.from = Candidate::From::features;
+  along.rank = 1;
+  along.from = Candidate::From::feature_rival;
+  v = decideOnCandidates({from_features, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_NE(v.reason.find("no dense search of the occupancy"), std::string::npos) << v.reason;
+}
 
 // A room at g 0.1: the right pose and a copy of it a wall along land alike
 // slice by slice, and no feature estimate tells them apart; the search of
