@@ -5,8 +5,9 @@
 #     `large` label, full-size worlds and the long equivalence checks, is left
 #     out: `ctest -L large` runs it; so is the hundred thousand fuzzed samples'
 #     test, which the sanitizer build runs, where a memory error is caught);
-#  2. a build with AddressSanitizer and UndefinedBehaviorSanitizer: the unit
-#     and daemon tests again, where any sanitizer report fails the run.
+#  2. a build with AddressSanitizer and UndefinedBehaviorSanitizer (compiled
+#     beside the release tests, at the lowest priority): the unit and daemon
+#     tests again, where any sanitizer report fails the run.
 # Each phase says how long it took (docs/results.md, "CI time", has the figures).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -19,14 +20,28 @@ took() { echo "== $1 took $((SECONDS - phase)) s ($((SECONDS - start)) s so far)
 
 scripts/build.sh
 took "release build"
+
+# The sanitizer build compiles beside the release tests at the lowest
+# priority: it takes what CPU they leave (fleets and links wait on their
+# peers; the link tests run alone at the end) and yields the rest to them.
+# Its log is shown if it fails.
+echo "== sanitizer build (ASan + UBSan) of the unit and daemon tests, beside the release tests"
+# Its own process group (setsid), so that a failed run stops all of it.
+mkdir -p build-asan
+BUILD_DIR=build-asan TARGETS=unit_and_daemon_tests \
+  setsid nice -n 19 scripts/build.sh -DTOMOMAP_SANITIZE=ON >build-asan/test-sh-build.log 2>&1 &
+sanitizer_build=$!
+trap 'kill -- -"$sanitizer_build" 2>/dev/null || true' EXIT
 (cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j"$jobs" --timeout 1200 -LE large \
   -E AHundredThousandFuzzedSamples)
 took "release tests"
-
-echo "== sanitizer build (ASan + UBSan): unit and daemon tests"
-BUILD_DIR=build-asan TARGETS=unit_and_daemon_tests \
-  scripts/build.sh -DTOMOMAP_SANITIZE=ON
-took "sanitizer build"
+if ! wait "$sanitizer_build"; then
+  cat build-asan/test-sh-build.log >&2
+  echo "== the sanitizer build failed (its log above)" >&2
+  exit 1
+fi
+trap - EXIT
+took "sanitizer build, the part left after the release tests"
 # new_delete_type_mismatch=0: Debian's Fast DDS 2.9.1 deletes its statistics
 # reader (StatisticsReaderImpl, 64 bytes) through a base pointer of 56 bytes
 # when a participant is deleted; that is in the library, not in tomomap.
