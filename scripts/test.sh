@@ -26,10 +26,15 @@ took "release build"
 # peers; the link tests run alone at the end) and yields the rest to them.
 # Its log is shown if it fails.
 echo "== sanitizer build (ASan + UBSan) of the unit and daemon tests, beside the release tests"
-# Its own process group (setsid), so that a failed run stops all of it.
+# Its own process group (setsid), so that a failed run stops all of it. A new
+# session is also a new scheduling autogroup where the kernel has them, which
+# competes with the tests' as an equal whatever its processes' nice: the
+# group's own nice is set to 19 as well (the release tests took 1,351 s
+# instead of 895 s beside the build without it).
 mkdir -p build-asan
-BUILD_DIR=build-asan TARGETS=unit_and_daemon_tests \
-  setsid nice -n 19 scripts/build.sh -DTOMOMAP_SANITIZE=ON >build-asan/test-sh-build.log 2>&1 &
+BUILD_DIR=build-asan TARGETS=unit_and_daemon_tests setsid bash -c \
+  '{ echo 19 >/proc/self/autogroup; } 2>/dev/null; exec nice -n 19 scripts/build.sh -DTOMOMAP_SANITIZE=ON' \
+  >build-asan/test-sh-build.log 2>&1 &
 sanitizer_build=$!
 trap 'kill -- -"$sanitizer_build" 2>/dev/null || true' EXIT
 (cd "${BUILD_DIR:-build}" && ctest --output-on-failure -j"$jobs" --timeout 1200 -LE large \

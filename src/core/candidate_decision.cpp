@@ -69,6 +69,56 @@ std::pair<double, int> votesLead(const Candidate& a, const Candidate& b) {
   return {signFlipLeadSigma(d), static_cast<int>(d.size())};
 }
 
+/// The decision's second step (decideOnCandidates), where the occupancy's
+/// slices do not tell: `best`, the candidate that lands the most, answers
+/// where a dense search of every pose ranks it first too (that search's own
+/// best pose lies at its place, ahead of its next beyond chance) and one of
+/// the features' slice-pair estimates agrees with it: evidence of another
+/// kind, found on descriptors alone. A small map's occupancy often places a
+/// right answer no more clearly than a copy of it a few cells along a wall;
+/// the features, which do not slide, tell them apart. A search's best pose
+/// within chance of its next ranks nothing: in a room with a copy of itself
+/// about 2.7 m along (room-low-11 at g 0.05, the pooled search's best 1.04x
+/// its next, 2.0 sigma) the features' estimates agreed with the copy.
+/// Whether it answered; `v` says why not.
+template <typename SamePlace>
+bool byCorroboration(CandidateVerdict& v, const std::vector<Candidate>& candidates, size_t best,
+                     const std::vector<int>& agreeing, const std::vector<SearchLead>& searches,
+                     const SamePlace& samePlace) {
+  const auto sigma = [](const SearchLead& s) { return significance(s.found.best.score(), s.found.next_score); };
+  bool searched = false;
+  const SearchLead* here = nullptr;  // of the searches whose best pose is at best's place, the clearest
+  for (const Candidate& c : candidates) {
+    if (!isDenseSearch(c.from)) continue;
+    searched = true;
+    if (c.rank != 0 || !samePlace(c, candidates[best])) continue;
+    for (const SearchLead& s : searches)
+      if (s.from == c.from && (!here || sigma(s) > sigma(*here))) here = &s;
+  }
+  if (!searched) {
+    v.reason += "; no dense search of the occupancy to corroborate it";
+    return false;
+  }
+  if (!here) {
+    v.reason += "; no dense search's best pose is at its place";
+    return false;
+  }
+  if (!beyondChance(here->found)) {
+    v.reason += "; " + std::string(fromName(here->from)) +
+                "'s best pose is at its place but within chance of its next (" + fixed(here->found.lead(), 2) + "x, " +
+                fixed(sigma(*here), 1) + " sigma)";
+    return false;
+  }
+  if (agreeing[best] == 0) {
+    v.reason += "; no slice-pair estimate of the features agrees with it";
+    return false;
+  }
+  v.answer = static_cast<int>(best);
+  v.on = CandidateVerdict::On::corroborated;
+  v.reason.clear();
+  return true;
+}
+
 /// The decision's third step (decideOnCandidates), where the occupancy does
 /// not tell (a street's poses along its facades land alike): the candidate
 /// the most slice-pair estimates of the features agree with (`agreeing`)
@@ -213,36 +263,10 @@ CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, co
                  : "the candidate that lands the most leads the best elsewhere by " + fixed(lead.first, 1) +
                        " sigma over " + std::to_string(lead.second) + " slices (need " + fixed(kClearSigma, 0) + ")";
 
-  // Corroboration: where the occupancy ranks one place first both among the
-  // candidates and in a dense search of every pose (that search's own best
-  // lies there, ahead of its next beyond chance), one of the features'
-  // slice-pair estimates agreeing with it is evidence of another kind, found
-  // on descriptors alone. A small map's occupancy often places a right answer
-  // no more clearly than a copy of it a few cells along a wall; the features,
-  // which do not slide, tell them apart. A search's best pose within chance
-  // of its next is no ranking: in a room with a copy of itself 2.6 m along
-  // (room-low-11 at g 0.05, the pooled search's best 1.04x its next, 2.0
-  // sigma) the features' estimates agreed with the copy.
-  const auto clearOfItsNext = [&](Candidate::From from) {
-    return std::any_of(searches.begin(), searches.end(),
-                       [&](const SearchLead& s) { return s.from == from && aheadBeyondChance(s.found, 1.0); });
-  };
-  const bool dense_best_here = std::any_of(candidates.begin(), candidates.end(), [&](const Candidate& c) {
-    return isDenseSearch(c.from) && c.rank == 0 && samePlace(c, candidates[best]) && clearOfItsNext(c.from);
-  });
-  if (dense_best_here && agreeing[best] > 0) {
-    v.answer = static_cast<int>(best);
-    v.on = CandidateVerdict::On::corroborated;
+  if (byCorroboration(v, candidates, best, agreeing, searches, samePlace)) {
     v.lead_sigma = lead.first, v.slices = lead.second;
-    v.reason.clear();
     return v;
   }
-  const bool searched =
-      std::any_of(candidates.begin(), candidates.end(), [](const Candidate& c) { return isDenseSearch(c.from); });
-  v.reason += !searched         ? "; no dense search of the occupancy to corroborate it"
-              : dense_best_here ? "; no slice-pair estimate of the features agrees with it"
-                                : "; no dense search's best pose clear of its next is at its place";
-
   if (!byVotes(v, candidates, scores, landed, agreeing, samePlace, bestElsewhere))
     bySecondLook(v, candidates, best, searches, params, tolerance, source_centre);
   return v;

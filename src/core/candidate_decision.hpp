@@ -25,7 +25,8 @@ struct CandidateVerdict {
   int answer = -1;  ///< index into the candidates; -1: no reliable match
   /// The evidence it answered on: the occupancy the candidate lands on; or,
   /// where that does not tell, the occupancy's best place corroborated by a
-  /// dense search's best pose and a feature estimate there; or the features'
+  /// dense search's best pose (ahead of its next beyond chance) and a feature
+  /// estimate there; or the features'
   /// slice-pair estimates it agrees with; or, last, the occupancy's best
   /// place where a dense search's own best pose is clear of its next and the
   /// same search with the maps' roles swapped finds it again.
@@ -78,6 +79,6 @@ const char* onName(CandidateVerdict::On on);
 /// search's best pose elsewhere leads its next so, and that search's second
 /// look finds it again (asked for by needs_look).
 CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, const MatchParams& params, double grid,
-                                    const Eigen::Vector2d& source_centre, const std::vector<SearchLead>& searches = {});
+                                    const Eigen::Vector2d& source_centre, const std::vector<SearchLead>& searches);
 
 }  // namespace tomomap

@@ -39,6 +39,10 @@ bool aheadBeyondChance(double score, double other, double by) {
 
 }  // namespace
 
+bool beyondChance(const DenseEvidence& d) {
+  return d.found && significance(d.best.score(), d.next_score) >= kBars.significant;
+}
+
 bool aheadBeyondChance(const DenseEvidence& d, double by) {
   return d.found && aheadBeyondChance(d.best.score(), d.next_score, by);
 }

@@ -134,6 +134,9 @@ struct DenseEvidence {
   double lead() const;
 };
 
+/// Whether a search found a best pose ahead of its next beyond chance
+/// (kBars.significant), by whatever ratio.
+bool beyondChance(const DenseEvidence& d);
 /// Whether a search found a best pose that leads its next by `by`, beyond
 /// chance (kBars.significant).
 bool aheadBeyondChance(const DenseEvidence& d, double by);

@@ -81,7 +81,7 @@ TEST(CandidateDecision, AVotesLeadCountsByItsSlicesNotByHowAlikeTheyAre) {
   Candidate voted = landing(0, 0, 0, 2, {40}), other = landing(20, 0, 2.0, 2, {40});
   voted.feature_votes = {1, 1};
   other.feature_votes = {0, 0};
-  const CandidateVerdict v = decideOnCandidates({voted, other}, p, 0.1, Eigen::Vector2d::Zero());
+  const CandidateVerdict v = decideOnCandidates({voted, other}, p, 0.1, Eigen::Vector2d::Zero(), {});
   EXPECT_EQ(v.answer, -1) << v.reason;
   EXPECT_NE(v.reason.find("by 1.4 sigma over 2 source slices"), std::string::npos) << v.reason;
 }
@@ -91,7 +91,7 @@ TEST(CandidateDecision, TheBestAnswersWhereItLeadsEveryPlaceElsewhereBeyondChanc
   std::vector<Candidate> c{landing(0, 0, 0, 20, {60, 70, 65}), landing(5, 0, 0, 20, {30, 20, 25}),
                            // within one tolerance (5 cells, 0.5 m) of the best: the same place, not a rival
                            landing(0.3, 0, 0, 20, {58, 71, 66})};
-  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero());
+  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {});
   ASSERT_EQ(v.answer, 0) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
   EXPECT_GE(v.lead_sigma, kClearSigma);
@@ -101,14 +101,14 @@ TEST(CandidateDecision, TheBestAnswersWhereItLeadsEveryPlaceElsewhereBeyondChanc
 TEST(CandidateDecision, TwoPlacesThatLandAlikeAreNoAnswer) {
   const MatchParams p = atTenCentimetres();
   std::vector<Candidate> c{landing(0, 0, 0, 20, {60, 50, 70}), landing(0, 0, 3.1, 20, {55, 65, 58})};
-  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero());
+  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {});
   EXPECT_EQ(v.answer, -1);
   EXPECT_NE(v.reason.find("sigma over 20 slices (need 3)"), std::string::npos) << v.reason;
   // One candidate alone has nothing to be clear of.
-  const CandidateVerdict alone = decideOnCandidates({c[0]}, p, 0.1, Eigen::Vector2d::Zero());
+  const CandidateVerdict alone = decideOnCandidates({c[0]}, p, 0.1, Eigen::Vector2d::Zero(), {});
   EXPECT_EQ(alone.answer, -1);
   EXPECT_NE(alone.reason.find("no candidate elsewhere"), std::string::npos) << alone.reason;
-  EXPECT_EQ(decideOnCandidates({}, p, 0.1, Eigen::Vector2d::Zero()).answer, -1);
+  EXPECT_EQ(decideOnCandidates({}, p, 0.1, Eigen::Vector2d::Zero(), {}).answer, -1);
 }
 
 TEST(CandidateDecision, WhereTheOccupancyDoesNotTellTheFeaturesVotesDoUnlessItTellsAgainstThem) {
@@ -122,13 +122,13 @@ TEST(CandidateDecision, WhereTheOccupancyDoesNotTellTheFeaturesVotesDoUnlessItTe
     right.feature_votes[k] = 3 + static_cast<int>(k % 2);
     along.feature_votes[k] = k % 3 == 0 ? 1 : 0;
   }
-  CandidateVerdict v = decideOnCandidates({along, right}, p, 0.1, Eigen::Vector2d::Zero());
+  CandidateVerdict v = decideOnCandidates({along, right}, p, 0.1, Eigen::Vector2d::Zero(), {});
   ASSERT_EQ(v.answer, 1) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::feature_votes);
   EXPECT_GE(v.lead_sigma, kClearSigma);
   // A third pose elsewhere that lands far more, slice by slice, tells against them.
   const Candidate clear = landing(-6, 2, 1.0, 20, {95, 90, 97});
-  v = decideOnCandidates({along, right, clear}, p, 0.1, Eigen::Vector2d::Zero());
+  v = decideOnCandidates({along, right, clear}, p, 0.1, Eigen::Vector2d::Zero(), {});
   EXPECT_EQ(v.answer, 2) << "the occupancy's clear best answers first: " << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
 }
@@ -137,7 +137,7 @@ TEST(CandidateDecision, EmptySpaceTheOtherMapSawCountsAgainstAPose) {
   const MatchParams p = atTenCentimetres();
   // The half-turned room lands more cells but twice as many of its cells in space the target saw empty.
   std::vector<Candidate> c{landing(0, 0, 3.1, 20, {80, 85, 82}, 100, 30), landing(0, 0, 0, 20, {60, 62, 61}, 100, 0)};
-  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero());
+  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {});
   EXPECT_EQ(v.answer, 1) << v.reason;
 }
 
@@ -178,8 +178,21 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   close[0].found.next_score = 600 / 1.04;
   v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero(), close);
   EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("no dense search's best pose clear of its next is at its place"), std::string::npos)
+  EXPECT_NE(v.reason.find("search_wide's best pose is at its place but within chance of its next (1.04x, 0.7 sigma)"),
+            std::string::npos)
       << v.reason;
+  // Another search clear of its next, whose best pose lies elsewhere, does not stand in for it.
+  std::vector<SearchLead> elsewhere = close;
+  elsewhere.push_back(searchLead(Candidate::From::search_pooled, 0.6, 0, 0, 900, 300));
+  v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero(), elsewhere);
+  EXPECT_EQ(v.answer, -1) << "search_pooled's best pose is the copy along the wall";
+  // Beyond chance by however small a ratio: 6,000 cells against 5,400 is 1.11x, 5.6 sigma.
+  std::vector<SearchLead> many = wide;
+  many[0].found.best.telling_inliers = 6000;
+  many[0].found.next_score = 5400;
+  v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero(), many);
+  EXPECT_EQ(v.answer, 0) << v.reason;
+  EXPECT_EQ(v.on, CandidateVerdict::On::corroborated);
 
   // No slice-pair estimate there: the occupancy's word alone, which is not clear.
   Candidate unvoted = right;
@@ -195,8 +208,7 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   along.rank = 0;
   v = decideOnCandidates({runner_up, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
   EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("no dense search's best pose clear of its next is at its place"), std::string::npos)
-      << v.reason;
+  EXPECT_NE(v.reason.find("no dense search's best pose is at its place"), std::string::npos) << v.reason;
 
   // The features' own answer is not a dense search: it corroborates nothing by itself.
   Candidate from_features = right;
