@@ -6,8 +6,8 @@
 #     out: `ctest -L large` runs it; so is the hundred thousand fuzzed samples'
 #     test, which the sanitizer build runs, where a memory error is caught);
 #  2. a build with AddressSanitizer and UndefinedBehaviorSanitizer (compiled
-#     beside the release tests): the unit and daemon
-#     tests again, where any sanitizer report fails the run.
+#     beside the release tests): the unit and daemon tests again, where any
+#     sanitizer report fails the run.
 # Each phase says how long it took (docs/results.md, "CI time", has the figures).
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -85,7 +85,6 @@ template <typename SamePlace>
 bool byCorroboration(CandidateVerdict& v, const std::vector<Candidate>& candidates, size_t best,
                      const std::vector<int>& agreeing, const std::vector<SearchLead>& searches,
                      const SamePlace& samePlace) {
-  const auto sigma = [](const SearchLead& s) { return significance(s.found.best.score(), s.found.next_score); };
   bool searched = false;
   const SearchLead* here = nullptr;  // of the searches whose best pose is at best's place, the clearest
   for (const Candidate& c : candidates) {
@@ -93,7 +92,7 @@ bool byCorroboration(CandidateVerdict& v, const std::vector<Candidate>& candidat
     searched = true;
     if (c.rank != 0 || !samePlace(c, candidates[best])) continue;
     for (const SearchLead& s : searches)
-      if (s.from == c.from && (!here || sigma(s) > sigma(*here))) here = &s;
+      if (s.from == c.from && (!here || s.found.leadSigma() > here->found.leadSigma())) here = &s;
   }
   if (!searched) {
     v.reason += "; no dense search of the occupancy to corroborate it";
@@ -106,7 +105,7 @@ bool byCorroboration(CandidateVerdict& v, const std::vector<Candidate>& candidat
   if (!beyondChance(here->found)) {
     v.reason += "; " + std::string(fromName(here->from)) +
                 "'s best pose is at its place but within chance of its next (" + fixed(here->found.lead(), 2) + "x, " +
-                fixed(sigma(*here), 1) + " sigma)";
+                fixed(here->found.leadSigma(), 1) + " sigma)";
     return false;
   }
   if (agreeing[best] == 0) {
@@ -195,7 +194,7 @@ void bySecondLook(CandidateVerdict& v, const std::vector<Candidate>& candidates,
     }
     v.answer = static_cast<int>(at);
     v.on = CandidateVerdict::On::second_look;
-    v.lead_sigma = significance(s.found.best.score(), s.found.next_score), v.slices = s.found.best.support;
+    v.lead_sigma = s.found.leadSigma(), v.slices = s.found.best.support;
     v.reason.clear();
     return;
   }

@@ -39,13 +39,9 @@ bool aheadBeyondChance(double score, double other, double by) {
 
 }  // namespace
 
-bool beyondChance(const DenseEvidence& d) {
-  return d.found && significance(d.best.score(), d.next_score) >= kBars.significant;
-}
+bool beyondChance(const DenseEvidence& d) { return d.found && d.leadSigma() >= kBars.significant; }
 
-bool aheadBeyondChance(const DenseEvidence& d, double by) {
-  return d.found && aheadBeyondChance(d.best.score(), d.next_score, by);
-}
+bool aheadBeyondChance(const DenseEvidence& d, double by) { return beyondChance(d) && d.lead() >= by; }
 
 bool leads(const DenseEvidence& d, double by, const MatchParams& params) {
   return aheadBeyondChance(d, by) && holdsOver(d.best, params.min_support);
@@ -87,7 +83,7 @@ bool outscores(const DensePose& p, double other, double by, const MatchParams& p
 std::string shortfall(const DenseEvidence& d, double by, int slices, int need) {
   std::string out = "lead " + fixed(d.lead(), 2) + "x";
   if (d.lead() < by) out += ", need " + fixed(by, 2) + "x";
-  const double sigma = significance(d.best.score(), d.next_score);
+  const double sigma = d.leadSigma();
   if (sigma < kBars.significant)
     out += "; " + fixed(sigma, 1) + " sigma beyond chance, need " + fixed(kBars.significant, 0);
   if (slices < need) out += "; over " + std::to_string(slices) + " slices, need " + std::to_string(need);
@@ -205,11 +201,13 @@ double answerLead(const Evidence& e, Verdict::By by) {
   if (at_features && e.features.support > 0) lead = significance(e.features.support, e.features.runner_up_support);
   for (const auto& [d, which] : searches)
     if (*d && (*d)->found && (which == by || (at_features && (*d)->at_features)))
-      lead = std::max(lead, significance((*d)->best.score(), (*d)->next_score));
+      lead = std::max(lead, (*d)->leadSigma());
   return lead;
 }
 
 double DenseEvidence::lead() const { return leadOver(best.score(), next_score); }
+
+double DenseEvidence::leadSigma() const { return significance(best.score(), next_score); }
 
 Verdict decideMatch(const Evidence& e, const MatchParams& params) {
   if (!e.tilted.empty()) return none(e.tilted);

@@ -132,6 +132,9 @@ struct DenseEvidence {
 
   /// The best pose's score over its next's; 0 where even the best contradicts more than it finds.
   double lead() const;
+  /// The same lead in sigmas of chance (significance): how far beyond what
+  /// two poses alike would score apart.
+  double leadSigma() const;
 };
 
 /// Whether a search found a best pose ahead of its next beyond chance
