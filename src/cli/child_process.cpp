@@ -67,10 +67,13 @@ ChildRun runChild(const std::vector<std::string>& argv, double timeout_s) {
   return r;
 }
 
-std::string siblingBinary(const std::string& name) {
+std::string selfBinary() {
   std::error_code ec;
-  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  return (self.parent_path() / name).string();
+  return std::filesystem::read_symlink("/proc/self/exe", ec).string();
+}
+
+std::string siblingBinary(const std::string& name) {
+  return (std::filesystem::path(selfBinary()).parent_path() / name).string();
 }
 
 }  // namespace tomomap::cli

@@ -21,4 +21,8 @@ ChildRun runChild(const std::vector<std::string>& argv, double timeout_s = 0);
 /// Absolute path of a binary installed beside the running one.
 std::string siblingBinary(const std::string& name);
 
+/// Absolute path of the running binary itself: a copy of it under another
+/// name (a build being compared with another) runs its own matches.
+std::string selfBinary();
+
 }  // namespace tomomap::cli

@@ -91,7 +91,7 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   fs::remove(json);
   std::vector<std::string> argv;
   if (method == "tomomap")
-    argv = {siblingBinary("tomomap"), "match", "-q"};
+    argv = {selfBinary(), "match", "-q"};
   else
     argv = {siblingBinary("tomomap-baseline"), "--method", method};
   if (method == "tomomap" && candidates) argv.push_back("--candidates");

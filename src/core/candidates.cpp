@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
+#include "dense_refine.hpp"
 #include "height_offsets.hpp"
 #include "nearby_poses.hpp"
 #include "verdict.hpp"
@@ -10,8 +12,8 @@
 namespace tomomap {
 namespace {
 
-/// Places climbed at most: each climb lands thousands of poses.
-constexpr size_t kMostClimbs = 4;
+/// Distinct places refined at most: a climb lands thousands of poses.
+constexpr size_t kMostRefined = 4;
 
 /// A height offset in slices as an offset in slices pooled by two.
 int pooledOffset(int offset) { return static_cast<int>(std::floor(offset / 2.0 + 0.5)); }
@@ -92,13 +94,16 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
     c.proposed_landed = c.landed = as_proposed[i];
     out.push_back(std::move(c));
   }
-  // The best distinct places as proposed climb, and every one takes the
-  // occupancy's height (small maps: on a large one a climb takes seconds,
-  // and its occupancy's height is not read, dense_opinion.cpp); two
-  // proposals are one place within looksApart at the source's centre and
-  // the smear of heights.
-  if (!denseSearchable(target.occupancy) || !denseSearchable(source.occupancy))
-    return finished(std::move(out), land, target, source, dp, votes);
+  // The best distinct places as proposed are refined. On maps small enough
+  // for a dense search each climbs uphill (nearby_poses.hpp): the pose the
+  // score judged lands most near it. On larger maps a climb of single cells
+  // took seconds (1,600 landings more on a campus pair), and one ICP on the
+  // occupancy from the proposal (dense_refine.hpp) takes a feature answer's
+  // pixel-quantised pose where the occupancy says, as a climb would, at a
+  // fraction of the time; on small maps the ICP in place of the climb
+  // answered fewer right and one wrong (docs/results.md, "Candidates on
+  // large maps"). Two proposals are one place within looksApart at the
+  // source's centre and the smear of heights.
   std::vector<size_t> order(out.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
@@ -106,21 +111,28 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
   ConsensusParams same = consensusParams(params, target.grid);
   same.translation_tolerance = looksApart(params, target.grid);
   const Eigen::Vector2d centre = source.occupancy.grid.centre();
-  std::vector<size_t> climbed;
+  const bool small = denseSearchable(target.occupancy) && denseSearchable(source.occupancy);
+  std::optional<OccupancyRefiner> icp;
+  if (!small) icp.emplace(target.occupancy, source.occupancy);
+  DenseRefineParams rp;
+  rp.threads = dp.threads;
+  std::vector<size_t> refined;
   for (size_t i : order) {
-    if (climbed.size() == kMostClimbs) break;
+    if (refined.size() == kMostRefined) break;
     Candidate& c = out[i];
-    const bool seen = std::any_of(climbed.begin(), climbed.end(), [&](size_t k) {
+    const bool seen = std::any_of(refined.begin(), refined.end(), [&](size_t k) {
       return onePlace(out[k].proposed, out[k].proposed_offset, c.proposed, c.proposed_offset, same, centre);
     });
     if (seen) continue;
-    climbed.push_back(i);
-    c.landed = uphill(land, target.occupancy, source.occupancy, c.proposed, c.proposed_offset, dp);
+    refined.push_back(i);
+    c.landed = small ? uphill(land, target.occupancy, source.occupancy, c.proposed, c.proposed_offset, dp)
+                     : landPose(land, (*icp)(c.proposed_offset, c.proposed, rp).transform, c.proposed_offset);
   }
   // Each at the height where most of the source's occupancy lands, within
   // half the smear of heights either side of its own, as the verdict places
-  // its answer (dense_opinion.cpp, takeOccupancyHeight): a climb weighs the
-  // telling cells alone, and a room's floor and ceiling are not telling.
+  // its answer (dense_opinion.cpp, takeOccupancyHeight): a climb and the
+  // features weigh telling cells alone, and a room's floor and ceiling are
+  // not telling.
   PoseLander::Poses moved;
   std::vector<size_t> which;
   for (size_t i = 0; i < out.size(); ++i) {

@@ -21,8 +21,9 @@ struct Candidate {
   Rigid2D proposed;           ///< as its search proposed it
   int proposed_offset = 0;    ///< [slices]
   DensePose proposed_landed;  ///< the proposal landed as it is
-  /// Refined (uphill, where it climbed; at the occupancy's height, on maps
-  /// small enough for a dense search) and landed: the pose judged.
+  /// Refined (uphill on small maps, by an ICP on the occupancy on larger
+  /// ones, where it was refined; at the occupancy's height) and landed: the
+  /// pose judged.
   DensePose landed;
   std::vector<SliceLanding> slices;  ///< `landed`, source slice by source slice
   /// `landed` on the occupancy pooled to twice the cell, slice by slice
@@ -58,11 +59,12 @@ struct Proposal {
 };
 
 /// Every proposal landed on the maps' occupancy as the dense search lands its
-/// poses (dense_search.hpp); on maps small enough for that search, the
-/// kMostClimbs best distinct places climb uphill (nearby_poses.hpp), and then
-/// every one takes the occupancy's height within half the smear of its own
-/// (PoseLander::heightOffset); on larger maps they stay as proposed. Empty
-/// where either map's occupancy is partial.
+/// poses (dense_search.hpp); the kMostRefined best distinct places are
+/// refined: uphill (nearby_poses.hpp) on maps small enough for a dense
+/// search, by one ICP on the occupancy (dense_refine.hpp) on larger ones.
+/// Then every one takes the occupancy's height within half the smear of its
+/// own (PoseLander::heightOffset). Empty where either map's occupancy is
+/// partial.
 std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeatures& source,
                                      const std::vector<Proposal>& proposals, const MatchParams& params,
                                      const FeatureVotes& votes = {});

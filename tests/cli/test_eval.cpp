@@ -161,6 +161,23 @@ TEST(Eval, OneThreadAskedKeepsEachRunOnOneCore) {
   }
 }
 
+// A build copied under another name to be compared with the installed one
+// evaluates itself: its matches are its own, not those of a `tomomap`
+// that happens to lie beside it (here there is none: every run would fail).
+TEST(Eval, ACopyUnderAnotherNameRunsItsOwnMatches) {
+  TempDir dir;
+  const std::string copy = dir / "tomomap-trial";
+  std::filesystem::copy_file(TOMOMAP_BIN, copy);
+  std::filesystem::permissions(copy, std::filesystem::perms::owner_exec, std::filesystem::perm_options::add);
+  std::ofstream(dir / "s.toml") << "name = \"trial\"\nmethods = [\"tomomap\"]\n[[synth]]\nworld = \"room\"\n"
+                                   "seeds = [1]\nnoise = [\"low\"]\ngrid = 0.1\n";
+  const auto r = test::runBinary(copy, "eval " + (dir / "s.toml") + " -o " + (dir / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto rows = jsonRows(dir);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_TRUE(rows[0]["exit_code"] == 0 || rows[0]["exit_code"] == 1) << rows[0].dump();
+}
+
 // The CI suite shipped with the project: both world types, three noise levels,
 // tomomap on every pair, the FPFH-RANSAC baseline beside it where the noise is
 // high. Asserts tomomap's success rate; timings are reported, never asserted.

@@ -32,6 +32,20 @@ SliceStack stackOf(const Points& p) { return makeSlices(voxelFilter(p, kGrid), k
 
 const ConsensusParams kSame{5 * kGrid, radians(10)};
 
+/// `map` as the target and as the source moved by `moved`, described, and
+/// the height offset in slices of the right pose.
+struct MovedMaps {
+  MapFeatures target, source;
+  int right_offset = 0;
+};
+MovedMaps describedMoved(const Points& map, const Pose4& moved, const MatchParams& params) {
+  const Points source = transformPoints(map, Pose4::fromMatrix(moved.matrix().inverse()));
+  MovedMaps out{describeMap(map, params), describeMap(source, params)};
+  const double z_between = out.target.occupancy.grid.z_min - out.source.occupancy.grid.z_min;
+  out.right_offset = static_cast<int>(std::lround((moved.z - z_between) / params.grid));
+  return out;
+}
+
 }  // namespace
 
 // The room moved by a yaw past a quarter turn and a shift: a pose the search
@@ -318,13 +332,10 @@ TEST(DenseSearch, TheOccupancysHeightIsWhereMostCellsLandTheOneAskedAboutOnATie)
 TEST(Candidates, AreJudgedAtTheHeightWhereTheOccupancyLandsMost) {
   const Points room = roomScan();
   const Pose4 moved{1.1, -0.6, 0.4, radians(35)};
-  const Points source = transformPoints(room, Pose4::fromMatrix(moved.matrix().inverse()));
   MatchParams params;
   params.grid = kGrid;
-  const MapFeatures t = describeMap(room, params), s = describeMap(source, params);
+  const auto [t, s, right] = describedMoved(room, moved, params);
   ASSERT_TRUE(denseSearchable(t.occupancy));
-  const int right =
-      static_cast<int>(std::lround((moved.z - (t.occupancy.grid.z_min - s.occupancy.grid.z_min)) / kGrid));
   const std::vector<Proposal> proposals{{Candidate::From::features, 0, 0, planar(moved), right + 2},
                                         {Candidate::From::feature_rival, 1, 0, planar(moved), right - 3}};
   const std::vector<Candidate> candidates = refineAndLand(t, s, proposals, params);
@@ -333,6 +344,35 @@ TEST(Candidates, AreJudgedAtTheHeightWhereTheOccupancyLandsMost) {
     SCOPED_TRACE(fromName(c.from));
     EXPECT_NEAR(c.landed.offset, right, 1);
   }
+}
+
+// A map too large for a dense search (the room and a copy of it turned a
+// quarter and 25 m along: 35 m across) and a proposal a few cells and a
+// degree off the right pose, as a feature answer on a few keypoints leaves
+// it: the candidate is judged, and would be answered, within a cell of the
+// right pose, landing more than as proposed.
+TEST(Candidates, OnAMapTooLargeForADenseSearchAreRefinedOntoTheOccupancy) {
+  Points map = roomScan();
+  const Points copy = transformPoints(roomScan(), Pose4{25.0, 3.0, 0.0, radians(90)});
+  map.insert(map.end(), copy.begin(), copy.end());
+  const Pose4 moved{1.1, -0.6, 0.0, radians(35)};
+  MatchParams params;
+  params.grid = kGrid;
+  const auto [t, s, right] = describedMoved(map, moved, params);
+  ASSERT_FALSE(denseSearchable(t.occupancy));
+  const Eigen::Vector2d centre = s.occupancy.grid.centre();
+  // The right pose turned a degree about the source's centre and shifted 0.2 m.
+  Rigid2D off = planar(moved);
+  off.yaw += radians(1);
+  off.t = planar(moved).apply(centre) + Eigen::Vector2d(0.2, -0.1) -
+          Rigid2D{off.yaw, Eigen::Vector2d::Zero()}.apply(centre);
+  const std::vector<Candidate> candidates =
+      refineAndLand(t, s, {{Candidate::From::features, 0, 0, off, right}}, params);
+  ASSERT_EQ(candidates.size(), 1u);
+  const Candidate& c = candidates.front();
+  EXPECT_GT(c.landed.score(), c.proposed_landed.score());
+  EXPECT_LT((c.landed.transform.apply(centre) - planar(moved).apply(centre)).norm(), kGrid);
+  EXPECT_LT(std::abs(wrapAngle(c.landed.transform.yaw - moved.yaw)), radians(0.2));
 }
 
 // The room on itself, started a few hundredths of a metre and a few
