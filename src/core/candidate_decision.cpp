@@ -139,10 +139,10 @@ bool byVotes(CandidateVerdict& v, const std::vector<Candidate>& candidates, cons
   const std::pair<double, int> by_votes = votesLead(candidates[voted], candidates[static_cast<size_t>(other)]);
   v.reason += "; the candidate most slice pairs agree with leads the most agreed-with elsewhere by " +
               fixed(by_votes.first, 1) + " sigma over " + std::to_string(by_votes.second) + " source slices";
-  if (by_votes.first < kClearSigma) return false;
+  if (by_votes.first < kBars.significant) return false;
   for (size_t i = 0; i < candidates.size(); ++i)
     if (!samePlace(candidates[i], candidates[voted]) && landed[i] > landed[voted] &&
-        occupancyLead(scores[i], scores[voted]).first >= kClearSigma) {
+        occupancyLead(scores[i], scores[voted]).first >= kBars.significant) {
       v.reason += ", but a candidate elsewhere lands more, beyond chance";
       return false;
     }
@@ -252,15 +252,15 @@ CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, co
   const int rival = bestElsewhere(best, lands_more);
   std::pair<double, int> lead{0.0, 0};
   if (rival >= 0) lead = occupancyLead(scores[best], scores[static_cast<size_t>(rival)]);
-  if (lead.first >= kClearSigma) {
+  if (lead.first >= kBars.significant) {
     v.answer = static_cast<int>(best);
     v.lead_sigma = lead.first, v.slices = lead.second;
     return v;
   }
-  v.reason = rival < 0
-                 ? "no candidate elsewhere to weigh the best against"
-                 : "the candidate that lands the most leads the best elsewhere by " + fixed(lead.first, 1) +
-                       " sigma over " + std::to_string(lead.second) + " slices (need " + fixed(kClearSigma, 0) + ")";
+  v.reason = rival < 0 ? "no candidate elsewhere to weigh the best against"
+                       : "the candidate that lands the most leads the best elsewhere by " + fixed(lead.first, 1) +
+                             " sigma over " + std::to_string(lead.second) + " slices (need " +
+                             fixed(kBars.significant, 0) + ")";
 
   if (byCorroboration(v, candidates, best, agreeing, searches, samePlace)) {
     v.lead_sigma = lead.first, v.slices = lead.second;

@@ -12,14 +12,6 @@
 
 namespace tomomap {
 
-/// The decision's own bar (its second look reads the dense searches' leads
-/// by the verdict's, kBars): a lead counts when chance alone would give it
-/// less often than a normal variable exceeds this many standard deviations
-/// (one-sided, 0.13 %).
-/// On the matrix's 316 pairs no answer was wrong from 3 (docs/results.md,
-/// "Candidates on the matrix"); it is not tuned below that.
-inline constexpr double kClearSigma = 3.0;
-
 /// What the decision over the candidates says.
 struct CandidateVerdict {
   int answer = -1;  ///< index into the candidates; -1: no reliable match
@@ -66,13 +58,13 @@ const char* onName(CandidateVerdict::On on);
 /// half the smear of heights. The candidate that lands the most (telling
 /// cells less twice the contradicted ones, slice by slice, on occupancy pooled
 /// to DenseSearchParams::finest_empty_cell where the grid is finer) answers if
-/// it leads the best candidate elsewhere by kClearSigma over the slices; else
+/// it leads the best candidate elsewhere by kBars.significant over the slices; else
 /// it answers as well where a dense search's best pose lies at its place,
 /// ahead of its next beyond chance (`searches`), and at least one of the
 /// features' slice-pair estimates agrees with it; else
 /// the one the most slice-pair estimates agree with answers if it leads the
-/// most agreed-with elsewhere by kClearSigma, source slice by source slice,
-/// and no candidate elsewhere lands kClearSigma more; else the one that lands
+/// most agreed-with elsewhere by kBars.significant, source slice by source slice,
+/// and no candidate elsewhere lands kBars.significant more; else the one that lands
 /// the most answers where the best pose of one of `searches` that answers
 /// alone in the verdict (at the grid, pooled) lies at its place, leads its
 /// next by kBars.dense_lead beyond chance over min_support slices, no

@@ -94,7 +94,7 @@ TEST(CandidateDecision, TheBestAnswersWhereItLeadsEveryPlaceElsewhereBeyondChanc
   const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {});
   ASSERT_EQ(v.answer, 0) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
-  EXPECT_GE(v.lead_sigma, kClearSigma);
+  EXPECT_GE(v.lead_sigma, kBars.significant);
   EXPECT_EQ(v.slices, 20);
 }
 
@@ -125,7 +125,7 @@ TEST(CandidateDecision, WhereTheOccupancyDoesNotTellTheFeaturesVotesDoUnlessItTe
   CandidateVerdict v = decideOnCandidates({along, right}, p, 0.1, Eigen::Vector2d::Zero(), {});
   ASSERT_EQ(v.answer, 1) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::feature_votes);
-  EXPECT_GE(v.lead_sigma, kClearSigma);
+  EXPECT_GE(v.lead_sigma, kBars.significant);
   // A third pose elsewhere that lands far more, slice by slice, tells against them.
   const Candidate clear = landing(-6, 2, 1.0, 20, {95, 90, 97});
   v = decideOnCandidates({along, right, clear}, p, 0.1, Eigen::Vector2d::Zero(), {});
@@ -171,7 +171,7 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   CandidateVerdict v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
   ASSERT_EQ(v.answer, 0) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::corroborated);
-  EXPECT_LT(v.lead_sigma, kClearSigma) << "the occupancy alone does not tell them apart";
+  EXPECT_LT(v.lead_sigma, kBars.significant) << "the occupancy alone does not tell them apart";
 
   // The search's best pose within chance of its next (1.04x, 0.7 sigma) ranks nothing.
   std::vector<SearchLead> close = wide;
