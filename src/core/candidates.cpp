@@ -112,8 +112,7 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
   same.translation_tolerance = looksApart(params, target.grid);
   const Eigen::Vector2d centre = source.occupancy.grid.centre();
   const bool small = denseSearchable(target.occupancy) && denseSearchable(source.occupancy);
-  std::optional<OccupancyRefiner> icp;
-  if (!small) icp.emplace(target.occupancy, source.occupancy);
+  const OccupancyRefiner icp(target.occupancy, source.occupancy);  // one preparation for every climb or ICP
   DenseRefineParams rp;
   rp.threads = dp.threads;
   std::vector<size_t> refined;
@@ -125,8 +124,8 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
     });
     if (seen) continue;
     refined.push_back(i);
-    c.landed = small ? uphill(land, target.occupancy, source.occupancy, c.proposed, c.proposed_offset, dp)
-                     : landPose(land, (*icp)(c.proposed_offset, c.proposed, rp).transform, c.proposed_offset);
+    c.landed = small ? uphill(land, icp, c.proposed, c.proposed_offset, dp.threads)
+                     : landPose(land, icp(c.proposed_offset, c.proposed, rp).transform, c.proposed_offset);
   }
   // Each at the height where most of the source's occupancy lands, within
   // half the smear of heights either side of its own, as the verdict places

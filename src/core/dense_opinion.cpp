@@ -137,7 +137,8 @@ void climbUphill(MatchResult& r, const PoseLander& land, const std::vector<std::
   const DensePose* start = &landed.front();
   for (const DensePose& p : landed)
     if (p.score() > start->score() && significance(p.score(), landed.front().score()) >= kBars.significant) start = &p;
-  const DensePose top = uphill(land, target.occupancy, source.occupancy, start->transform, start->offset, dp);
+  const DensePose top =
+      uphill(land, OccupancyRefiner(target.occupancy, source.occupancy), start->transform, start->offset, dp.threads);
   r.T_target_source = poseAt(top.transform, top.offset, target, source);
   r.height_offset = top.offset;
 }

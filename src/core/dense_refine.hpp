@@ -38,6 +38,8 @@ class OccupancyRefiner {
  public:
   OccupancyRefiner(const SliceStack& target, const SliceStack& source);
   DenseRefineResult operator()(int offset, const Rigid2D& initial, const DenseRefineParams& params = {}) const;
+  const SliceStack& target() const { return target_; }
+  const SliceStack& source() const { return source_; }
 
  private:
   const SliceStack &target_, &source_;

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "dense_refine.hpp"
-
 namespace tomomap {
 namespace {
 
@@ -81,19 +79,18 @@ DensePose bestAround(const SliceStack& target, const SliceStack& source, const R
 
 DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                  const DenseSearchParams& params) {
-  return uphill(PoseLander(target, source, params), target, source, T, offset, params);
+  return uphill(PoseLander(target, source, params), OccupancyRefiner(target, source), T, offset, params.threads);
 }
 
-DensePose uphill(const PoseLander& land, const SliceStack& target, const SliceStack& source, const Rigid2D& T,
-                 int offset, const DenseSearchParams& params) {
-  const double cell = target.grid.cell;
-  DensePose top = climb(land, source.grid, cell, landPose(land, T, offset));
+DensePose uphill(const PoseLander& land, const OccupancyRefiner& refine, const Rigid2D& T, int offset, int threads) {
+  const SliceGrid& source = refine.source().grid;
+  const double cell = refine.target().grid.cell;
+  DensePose top = climb(land, source, cell, landPose(land, T, offset));
   DenseRefineParams refine_params;
-  refine_params.threads = params.threads;
-  const OccupancyRefiner refine(target, source);
+  refine_params.threads = threads;
   for (int round = 0; round < kMaxRefinements; ++round) {
     const Rigid2D refined = refine(top.offset, top.transform, refine_params).transform;
-    const DensePose next = climb(land, source.grid, cell, landPose(land, refined, top.offset));
+    const DensePose next = climb(land, source, cell, landPose(land, refined, top.offset));
     if (next.score() <= top.score()) break;
     top = next;
   }

@@ -1,6 +1,7 @@
 #pragma once
 // The poses near a pose on the maps' occupancy: how well the occupancy pins it
 // down (the best of the poses around it), and the pose uphill of it.
+#include "dense_refine.hpp"
 #include "dense_search.hpp"
 
 namespace tomomap {
@@ -28,9 +29,9 @@ DensePose bestAround(const SliceStack& target, const SliceStack& source, const R
 /// (T, offset) itself, landed, where nothing uphill lands more or either stack is partial.
 DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                  const DenseSearchParams& params = {});
-/// uphill with `land`, a lander of `target` and `source` (dense_search.hpp)
-/// the caller has prepared already: one preparation serves every step.
-DensePose uphill(const PoseLander& land, const SliceStack& target, const SliceStack& source, const Rigid2D& T,
-                 int offset, const DenseSearchParams& params = {});
+/// uphill with `land` and `refine`, a lander and a refiner of the same two
+/// stacks (dense_search.hpp, dense_refine.hpp) the caller has prepared
+/// already: one preparation serves every step of every climb on them.
+DensePose uphill(const PoseLander& land, const OccupancyRefiner& refine, const Rigid2D& T, int offset, int threads = 1);
 
 }  // namespace tomomap
