@@ -12,14 +12,18 @@
 namespace tomomap {
 namespace {
 
-/// Per slice: what a candidate lands there (telling cells less twice those in
-/// space the target saw empty) and its telling cells.
+/// Per slice: what a candidate lands there (telling cells, less those in
+/// space the target saw empty as DensePose::score weighs them) and its
+/// telling cells. One way, the source's cells on the target: judged both
+/// ways (the climb's own score, slice pair by slice pair) the matrix
+/// answered two crops wrong that this refuses (docs/results.md, "Four more
+/// tries at the decision").
 using SliceScores = std::map<int, std::pair<double, double>>;
 
 SliceScores occupancyBySlice(const Candidate& c) {
   SliceScores out;
   for (const SliceLanding& s : c.pooled_slices.empty() ? c.slices : c.pooled_slices)
-    if (s.telling > 0) out[s.slice] = {s.telling_on - 2.0 * s.contradicted, s.telling};
+    if (s.telling > 0) out[s.slice] = {s.telling_on - kContradictionWeight * s.contradicted, s.telling};
   return out;
 }
 
@@ -153,20 +157,27 @@ bool byVotes(CandidateVerdict& v, const std::vector<Candidate>& candidates, cons
   return true;
 }
 
-/// The decision's last step (decideOnCandidates): `best`, the candidate that
-/// lands the most, answers where a search that answers alone in the verdict
-/// (at the grid, pooled) puts its own best pose there, clear of its next,
-/// and finds it again with the maps' roles swapped: the verdict's evidence
-/// for such a pose, read in the decision's terms. The occupancy's slices
-/// may not tell a room's right place from a copy of it a wall along (rooms
-/// at g 0.1: 2.5-2.9 sigma), where the whole occupancy, searched both ways,
-/// does. A search's clear best pose elsewhere tells against it: on a real
-/// RGB-D crop (sunrgbd-room-once-wrong-200, g 0.05) the pooled search's best
-/// led 1.62x and was found again, and was wrong; the grid's best lay
-/// elsewhere, 1.96x ahead (docs/results.md, "Other tests for the decision,
-/// replayed"). Found again is at the same place (SecondLook::same_place),
-/// without the verdict's further bar on where the two looks put the source's
-/// origin (looksApart): the suites were measured so.
+/// The decision's last step (decideOnCandidates): a search that answers
+/// alone in the verdict (at the grid, pooled) whose own best pose lies at
+/// the place of `best`, the candidate that lands the most, clear of its
+/// next, answers that pose (its candidate, climbed) where it finds it again
+/// with the maps' roles swapped: the verdict's evidence for such a pose,
+/// read in the decision's terms. The occupancy's slices may not tell a
+/// room's right place from a copy of it a wall along (rooms at g 0.1:
+/// 2.5-2.9 sigma), where the whole occupancy, searched both ways, does. The
+/// pose found twice is the pose answered, not another at its place that
+/// lands a little more (on a real RGB-D crop, sunrgbd-room-38 at g 0.1, one
+/// climbed onto a single slice 0.64 m off). The wide search does not look
+/// again: its second look answered 7 more RGB-D crops of the matrix right,
+/// and 2 of the unseen seeds wrong, 8-10 cells off at g 0.05
+/// (docs/results.md, "Four more tries at the decision"). A search's clear
+/// best pose elsewhere tells against it: on a real RGB-D crop
+/// (sunrgbd-room-once-wrong-200, g 0.05) the pooled search's best led 1.62x
+/// and was found again, and was wrong; the grid's best lay elsewhere, 1.96x
+/// ahead (docs/results.md, "Other tests for the decision, replayed"). Found
+/// again is at the same place (SecondLook::same_place), without the
+/// verdict's further bar on where the two looks put the source's origin
+/// (looksApart): the suites were measured so.
 void bySecondLook(CandidateVerdict& v, const std::vector<Candidate>& candidates, size_t at,
                   const std::vector<SearchLead>& searches, const MatchParams& params, const ConsensusParams& tolerance,
                   const Eigen::Vector2d& centre) {
@@ -192,7 +203,11 @@ void bySecondLook(CandidateVerdict& v, const std::vector<Candidate>& candidates,
                   (s.look->found ? "another place, " + fixed(s.look->apart, 2) + " m apart" : "no pose");
       continue;
     }
+    // The pose found again is the search's own best, as its candidate
+    // climbed: the pose vouched for is the pose answered.
     v.answer = static_cast<int>(at);
+    for (size_t i = 0; i < candidates.size(); ++i)
+      if (candidates[i].from == s.from && candidates[i].rank == 0) v.answer = static_cast<int>(i);
     v.on = CandidateVerdict::On::second_look;
     v.lead_sigma = s.found.leadSigma(), v.slices = s.found.best.support;
     v.reason.clear();

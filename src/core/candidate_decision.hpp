@@ -19,9 +19,9 @@ struct CandidateVerdict {
   /// where that does not tell, the occupancy's best place corroborated by a
   /// dense search's best pose (ahead of its next beyond chance) and a feature
   /// estimate there; or the features'
-  /// slice-pair estimates it agrees with; or, last, the occupancy's best
-  /// place where a dense search's own best pose is clear of its next and the
-  /// same search with the maps' roles swapped finds it again.
+  /// slice-pair estimates it agrees with; or, last, a dense search's own
+  /// best pose at the occupancy's best place, clear of its next and found
+  /// again by the same search with the maps' roles swapped.
   enum class On { occupancy, corroborated, feature_votes, second_look } on = On::occupancy;
   /// The answer's lead over the best candidate elsewhere; on a second look,
   /// its search's best pose's over its next [normal sigmas].
@@ -64,12 +64,13 @@ const char* onName(CandidateVerdict::On on);
 /// features' slice-pair estimates agrees with it; else
 /// the one the most slice-pair estimates agree with answers if it leads the
 /// most agreed-with elsewhere by kBars.significant, source slice by source slice,
-/// and no candidate elsewhere lands kBars.significant more; else the one that lands
-/// the most answers where the best pose of one of `searches` that answers
-/// alone in the verdict (at the grid, pooled) lies at its place, leads its
-/// next by kBars.dense_lead beyond chance over min_support slices, no
-/// search's best pose elsewhere leads its next so, and that search's second
-/// look finds it again (asked for by needs_look).
+/// and no candidate elsewhere lands kBars.significant more; else the best
+/// pose of one of `searches` that answers alone in the verdict (at the
+/// grid, pooled) answers (its candidate) where it lies at the place of the
+/// one that lands the most, leads its next by kBars.dense_lead beyond chance
+/// over min_support slices, no search's best pose elsewhere leads its next
+/// so, and that search's second look finds it again (asked for by
+/// needs_look).
 CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, const MatchParams& params, double grid,
                                     const Eigen::Vector2d& source_centre, const std::vector<SearchLead>& searches);
 

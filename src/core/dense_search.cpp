@@ -18,15 +18,6 @@
 
 namespace tomomap {
 
-/// A telling cell where the other map saw empty space counts against a pose
-/// twice what one landing on occupancy counts for it. Room pairs (seeds
-/// 1-100, low and high noise) at g 0.1: the best pose was right and 1.4x
-/// ahead of its next on 137 of 200 at weight 0, 197 at 2, 198 at 3 and 4. On
-/// occupancy pooled from g 0.05 to 0.1 m, the one wrong best pose (seed 11,
-/// one enclosure laid on a like one) led by 1.14x at 2, 1.33x at 3 and 1.68x
-/// at 4 (docs/results.md, "Empty space").
-constexpr double kContradictionWeight = 2.0;
-
 double DensePose::score() const {
   return static_cast<double>(telling_inliers) - kContradictionWeight * static_cast<double>(contradicted);
 }
