@@ -123,8 +123,6 @@ void answer(MatchResult& r, const Opinion& o, const MapFeatures& target, const M
 /// landing 5,724 against the answer's 5,688 climbed to 0.27 m off, not 0.13.
 void climbUphill(MatchResult& r, const PoseLander& land, const std::vector<std::pair<Rigid2D, int>>& found,
                  const MapFeatures& target, const MapFeatures& source, const MatchParams& params) {
-  DenseSearchParams dp;
-  dp.threads = matchThreads(params);
   const Rigid2D answer = planar(r.T_target_source);
   ConsensusParams same = consensusParams(params, target.grid);
   same.translation_tolerance = looksApart(params, target.grid);
@@ -137,8 +135,8 @@ void climbUphill(MatchResult& r, const PoseLander& land, const std::vector<std::
   const DensePose* start = &landed.front();
   for (const DensePose& p : landed)
     if (p.score() > start->score() && significance(p.score(), landed.front().score()) >= kBars.significant) start = &p;
-  const DensePose top =
-      uphill(land, OccupancyRefiner(target.occupancy, source.occupancy), start->transform, start->offset, dp.threads);
+  const DensePose top = uphill(land, OccupancyRefiner(target.occupancy, source.occupancy), start->transform,
+                               start->offset, matchThreads(params));
   r.T_target_source = poseAt(top.transform, top.offset, target, source);
   r.height_offset = top.offset;
 }
