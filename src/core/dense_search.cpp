@@ -77,28 +77,52 @@ std::vector<Cell> cellsOf(const SliceStack& s, double wall_spread) {
   return out;
 }
 
-/// Per raster pixel, the lowest and highest slice its column is occupied in.
-/// A map saw through the empty cells of a column between occupancy below and
-/// above (floor and ceiling, floor and table), as a room's scan sees its
-/// inside; a column open at the bottom or top may be unseen or outside. Two
-/// slices of margin each way, for a floor's or ceiling's thickness under noise.
-struct Enclosure {
-  static constexpr int kMargin = 2;  ///< [slices]
-  std::vector<int> lowest, highest;
-
+/// Where a map saw through empty space: a cell of a column between occupancy
+/// below and above (floor and ceiling, floor and table), as a room's scan
+/// sees its inside; a column open at the bottom or top may be unseen or
+/// outside. Two slices of margin each way, for a floor's or ceiling's
+/// thickness under noise. The occupancy must lie in the cell's storey, the
+/// run of heights the map saw (SliceStack::seen) around it: a height at which
+/// it saw nothing (a slab between two floors) was not seen through, so the
+/// floor of a storey above does not enclose the room below, and two like
+/// floors enclose alike.
+class Enclosure {
+ public:
   explicit Enclosure(const SliceStack& s)
-      : lowest(static_cast<size_t>(s.grid.width) * static_cast<size_t>(s.grid.height), s.size()),
-        highest(lowest.size(), -1) {
+      : first_(static_cast<size_t>(s.grid.width) * static_cast<size_t>(s.grid.height) + 1, 0),
+        storey_(static_cast<size_t>(s.size())) {
+    // Each column's occupied slices, ascending (a counting sort by pixel).
+    for (const auto& cells : s.cells)
+      for (uint32_t idx : cells) ++first_[idx + 1];
+    for (size_t p = 1; p < first_.size(); ++p) first_[p] += first_[p - 1];
+    slices_.resize(first_.back());
+    std::vector<uint32_t> next(first_.begin(), first_.end() - 1);
     for (int k = 0; k < s.size(); ++k)
-      for (uint32_t idx : s.cells[static_cast<size_t>(k)]) {
-        lowest[idx] = std::min(lowest[idx], k);
-        highest[idx] = std::max(highest[idx], k);
-      }
+      for (uint32_t idx : s.cells[static_cast<size_t>(k)]) slices_[next[idx]++] = static_cast<uint16_t>(k);
+    const auto seen = [&](int k) { return s.seen.empty() || s.seen[static_cast<size_t>(k)]; };
+    for (int k = 0; k < s.size();) {
+      int end = k;
+      while (seen(end) && end + 1 < s.size() && seen(end + 1)) ++end;
+      for (int i = k; i <= end; ++i) storey_[static_cast<size_t>(i)] = {k, end};
+      k = end + 1;
+    }
   }
-  /// Whether pixel `idx` of slice `k` lies between occupancy below and above.
+  /// Whether pixel `idx` of slice `k` lies between occupancy below and above in its storey.
   bool encloses(int idx, int k) const {
-    return lowest[static_cast<size_t>(idx)] <= k - kMargin && highest[static_cast<size_t>(idx)] >= k + kMargin;
+    const auto [lowest, highest] = storey_[static_cast<size_t>(k)];
+    const auto begin = slices_.begin() + first_[static_cast<size_t>(idx)],
+               end = slices_.begin() + first_[static_cast<size_t>(idx) + 1];
+    const auto above = std::lower_bound(begin, end, k + kMargin);
+    if (above == end || *above > highest) return false;
+    const auto below = std::upper_bound(begin, end, k - kMargin);
+    return below != begin && *(below - 1) >= lowest;
   }
+
+ private:
+  static constexpr int kMargin = 2;          ///< [slices]
+  std::vector<uint32_t> first_;              ///< per pixel, where its column starts in slices_ (and one past the last)
+  std::vector<uint16_t> slices_;             ///< each column's occupied slices, ascending
+  std::vector<std::pair<int, int>> storey_;  ///< per slice, its storey's lowest and highest slice
 };
 
 /// The packed real spectrum (OpenCV's CCS) of a coarse binary `image`

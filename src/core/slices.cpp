@@ -41,10 +41,13 @@ void trimEnds(SliceStack& stack) {
   auto last = std::find_if(cells.rbegin(), cells.rend(), [](const auto& c) { return !c.empty(); }).base();
   if (first >= last) {
     cells.clear();
+    stack.seen.clear();
     return;
   }
-  stack.grid.z_min = stack.grid.sliceHeight(static_cast<int>(first - cells.begin()));
+  const auto lowest = first - cells.begin(), highest = last - cells.begin();
+  stack.grid.z_min = stack.grid.sliceHeight(static_cast<int>(lowest));
   cells = std::vector<std::vector<uint32_t>>(std::make_move_iterator(first), std::make_move_iterator(last));
+  if (!stack.seen.empty()) stack.seen = std::vector<bool>(stack.seen.begin() + lowest, stack.seen.begin() + highest);
 }
 
 }  // namespace
@@ -113,6 +116,9 @@ SliceStack makeSlices(const Points& points, double cell, int threads, const Slic
       if (const auto at = place(p)) grouped[next[at->first]++] = at->second;
   }
 
+  stack.seen.resize(slices);
+  for (size_t k = 0; k < slices; ++k) stack.seen[k] = start[k + 1] > start[k];
+
   const auto min_cells = static_cast<size_t>(sparsest * (g.width + g.height));
   const size_t raster_words = (static_cast<size_t>(g.width) * static_cast<size_t>(g.height) + 63) / 64;
   auto& cells = stack.cells;
@@ -167,6 +173,10 @@ SliceStack pooled(const SliceStack& fine) {
   const auto w = static_cast<uint32_t>(fine.grid.width), W = static_cast<uint32_t>(out.grid.width);
   for (size_t k = 0; k < fine.cells.size(); ++k)
     for (uint32_t idx : fine.cells[k]) out.cells[k / 2].push_back(idx / w / 2 * W + idx % w / 2);
+  if (!fine.seen.empty()) {
+    out.seen.assign(out.cells.size(), false);
+    for (size_t k = 0; k < fine.seen.size(); ++k) out.seen[k / 2] = out.seen[k / 2] || fine.seen[k];
+  }
   for (auto& c : out.cells) {
     std::sort(c.begin(), c.end());
     c.erase(std::unique(c.begin(), c.end()), c.end());

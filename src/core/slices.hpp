@@ -45,7 +45,11 @@ struct SliceGrid {
 struct SliceStack {
   SliceGrid grid;
   std::vector<std::vector<uint32_t>> cells;  ///< per slice; empty = too sparse to describe (kSparsestSlice)
-  size_t stray = 0;                          ///< points left out as stray returns (map_bounds.hpp)
+  /// Per slice, whether the map had any point at its height: a slice too
+  /// sparse to describe was seen, a slab between two floors was not. Empty
+  /// where not known (a stack that crossed the network): every slice seen.
+  std::vector<bool> seen{};
+  size_t stray = 0;  ///< points left out as stray returns (map_bounds.hpp)
   /// Some slices' cells are not here: they crossed the network as features.
   bool partial = false;
 

@@ -34,6 +34,23 @@ bool acceptable(const wire::FeatureSettings& fs) {
   return features.inRange(fs.max_features()) && fast.inRange(fs.fast_threshold()) && fs.pad() <= kMaxPad;
 }
 
+/// The runs of slices at whose height the map had no point
+/// (SliceStack::seen), each its first and last slice, as the announcement
+/// carries them: the lowest wire::MAX_SLICES / 2 runs (of a map with more, a
+/// receiver reads the rest as seen, as it reads a stack that does not say).
+std::vector<int32_t> unseenRuns(const std::vector<bool>& seen) {
+  std::vector<int32_t> runs;
+  for (size_t k = 0; k < seen.size() && runs.size() + 2 <= wire::MAX_SLICES; ++k) {
+    if (seen[k]) continue;
+    size_t last = k;
+    while (last + 1 < seen.size() && !seen[last + 1]) ++last;
+    runs.push_back(static_cast<int32_t>(k));
+    runs.push_back(static_cast<int32_t>(last));
+    k = last;
+  }
+  return runs;
+}
+
 template <typename T>
 std::vector<std::vector<T>> split(const std::vector<T>& items, size_t per_part) {
   std::vector<std::vector<T>> parts;
@@ -95,6 +112,7 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const Feature
   a.width(static_cast<uint16_t>(g.width));
   a.height(static_cast<uint16_t>(g.height));
   a.slice_count(f.slice_count);
+  a.unseen(unseenRuns(f.occupancy.seen));
   a.raw_bytes(raw_bytes);
   a.features().max_features(static_cast<uint16_t>(params.max_features));
   a.features().fast_threshold(static_cast<uint16_t>(params.fast_threshold));
@@ -229,7 +247,16 @@ uint64_t mapVersion(const wire::MapAnnouncement& a) {
     mix((uint64_t{static_cast<uint32_t>(e.slice())} << 32) | e.crc32());
     mix(e.parts());
   }
+  for (int32_t k : a.unseen()) mix(static_cast<uint32_t>(k));
   return h;
+}
+
+std::vector<bool> seenOf(const wire::MapAnnouncement& a) {
+  std::vector<bool> seen(static_cast<size_t>(std::max(a.slice_count(), 0)), true);
+  for (size_t i = 0; i + 1 < a.unseen().size(); i += 2)
+    for (int32_t k = std::max(a.unseen()[i], 0); k <= a.unseen()[i + 1] && k < a.slice_count(); ++k)
+      seen[static_cast<size_t>(k)] = false;
+  return seen;
 }
 
 Eigen::Vector3d upOf(const wire::MapAnnouncement& a) { return {a.up()[0], a.up()[1], a.up()[2]}; }
@@ -255,12 +282,22 @@ Rejection validate(const wire::MapAnnouncement& a) {
   // A slice can never need more than its deflated raster or its announced features.
   const size_t cap = std::max<size_t>(compressBound(static_cast<uLong>(rasterBytes(a.width(), a.height()))),
                                       size_t{fs.max_features()} * kFeatureBytes);
-  std::set<int> seen;
+  std::set<int> listed;
   for (const auto& e : a.slices()) {
-    if (e.slice() < 0 || e.slice() >= a.slice_count() || !seen.insert(e.slice()).second)
+    if (e.slice() < 0 || e.slice() >= a.slice_count() || !listed.insert(e.slice()).second)
       return {Reject::SliceOutOfRange, e.slice()};
     if (e.parts() == 0 || e.parts() > 1024) return {Reject::BadPartCount, e.slice()};
     if (e.bytes() > cap) return {Reject::OversizedSlice, e.slice()};
+  }
+  // Unseen runs in pairs, in range, ascending and apart, over no slice it sends (a slice with cells was seen).
+  const auto& unseen = a.unseen();
+  if (unseen.size() % 2 != 0) return {Reject::BadUnseen};
+  for (size_t i = 0; i < unseen.size(); i += 2) {
+    const int32_t first = unseen[i], last = unseen[i + 1];
+    const bool apart = i == 0 || first > unseen[i - 1] + 1;
+    if (first < 0 || first > last || last >= a.slice_count() || !apart ||
+        listed.lower_bound(first) != listed.upper_bound(last))
+      return {Reject::BadUnseen, first};
   }
   if (a.version() != mapVersion(a)) return {Reject::VersionMismatch};
   return {};

@@ -63,6 +63,9 @@ uint64_t mapVersion(const wire::MapAnnouncement& a);
 
 /// The feature settings an announcement carries, as the core takes them.
 FeatureParams featureParamsOf(const wire::MapAnnouncement& a);
+/// Per slice of the announced map, whether it had any point at that height
+/// (SliceStack::seen).
+std::vector<bool> seenOf(const wire::MapAnnouncement& a);
 /// The up direction the announced map's slices are level to, in its own frame.
 Eigen::Vector3d upOf(const wire::MapAnnouncement& a);
 

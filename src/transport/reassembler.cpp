@@ -107,6 +107,7 @@ MapFeatures Reassembler::build() const {
   SliceStack stack;
   stack.grid = {a.grid(), a.x_min(), a.y_min(), a.z_min(), a.width(), a.height()};
   stack.cells.resize(static_cast<size_t>(a.slice_count()));
+  stack.seen = seenOf(a);
   std::vector<SliceFeatures> sent_as_features;
   for (const auto& [index, parts] : done_) {
     if (parts.front().encoding() == wire::SliceEncoding::OCCUPANCY)

@@ -22,6 +22,9 @@ std::string Rejection::text() const {
       return "announcement with feature settings out of range";
     case Reject::VersionMismatch:
       return "announcement whose version does not match its content";
+    case Reject::BadUnseen:
+      return "announcement with unseen slices out of range, out of order or sent (from slice " + std::to_string(slice) +
+             ")";
     case Reject::BadUp:
       return "an up direction that is not a unit vector within 30 deg of z";
     case Reject::NotAnnounced:

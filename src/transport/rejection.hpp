@@ -16,6 +16,7 @@ enum class Reject {
   OversizedSlice,  ///< announcement: a slice larger than any real slice can be
   BadFeatureSettings,
   VersionMismatch,  ///< announcement whose version is not the hash of its content
+  BadUnseen,        ///< announcement: an unseen run out of range, out of order or over a slice it sends
   BadUp,            ///< announcement or estimate: an up that is not a unit vector within 30 deg of z
   NotAnnounced,     ///< sample of a slice the announcement does not list
   PartNumbering,

@@ -138,6 +138,34 @@ TEST(DenseSearch, LandingAGivenPoseTalliesItAsTheSearchDoes) {
   EXPECT_GT(turned.contradicted, itself.contradicted + 100) << turned.telling_inliers << " telling";
 }
 
+// A room under a like storey 4 m above, a slab between that no scan saw: a
+// pose of the room lands as much in empty space on either storey as on the
+// room alone. The storey above does not enclose the room below: the heights
+// between them, where the map saw nothing, were not seen through (else a
+// pick between two like floors would read the lower one as contradicted).
+TEST(DenseSearch, AStoreyAboveEnclosesNothingInTheOneBelow) {
+  const SliceStack room = stackOf(roomScan());
+  const int storey = static_cast<int>(std::lround(4.0 / kGrid));
+  ASSERT_LT(room.size(), storey);
+  SliceStack both = room;  // the room's very slices again, 4 m up, nothing seen between
+  ASSERT_EQ(room.seen.size(), room.cells.size());
+  both.cells.resize(static_cast<size_t>(storey));
+  both.cells.insert(both.cells.end(), room.cells.begin(), room.cells.end());
+  both.seen.resize(static_cast<size_t>(storey), false);
+  both.seen.insert(both.seen.end(), room.seen.begin(), room.seen.end());
+  const Eigen::Vector2d centre(room.grid.x_min + 0.5 * room.grid.width * kGrid,
+                               room.grid.y_min + 0.5 * room.grid.height * kGrid);
+  Rigid2D half{kPi, Eigen::Vector2d::Zero()};
+  half.t = centre - half.apply(centre);  // turned about the room's centre
+  const DensePose alone = landPose(room, room, half, 0);
+  const DensePose below = landPose(both, room, half, 0), above = landPose(both, room, half, storey);
+  std::cout << alone.contradicted << " cells in empty space on the room alone, " << below.contradicted
+            << " on the storey below, " << above.contradicted << " on the storey above\n";
+  ASSERT_GT(alone.contradicted, 100u);
+  EXPECT_EQ(below.contradicted, alone.contradicted);
+  EXPECT_EQ(above.contradicted, alone.contradicted);
+}
+
 // Two crops of one room sharing a fifth of it, at the right pose: a slice
 // cannot land half of all its cells on the other crop (most lie where the
 // other never looked), but it lands half of those that fall where the other

@@ -142,6 +142,40 @@ TEST(SliceCodec, InconsistentSamplesAreRejectedNotCrashed) {
   EXPECT_EQ(validate(a), Reject::BadFeatureSettings);
 }
 
+// The heights at which a map had no point (the slab between the building's
+// floors) travel with it: a receiver judges the empty space a pose lands in
+// as the owner does (dense_search.cpp, Enclosure). Announcements that lie
+// about them are refused.
+TEST(SliceCodec, TheHeightsAMapSawNothingAtTravelWithIt) {
+  synth::SceneParams sp;
+  sp.type = synth::WorldType::Room;
+  const Points room = synth::scanScene(synth::makeScene(sp), synth::noiseLevel("low"), 1).front().points;
+  Points storeys = room;  // the room again 6 m up, nothing between
+  for (const auto& p : room) storeys.push_back(p + Eigen::Vector3f(0, 0, 6.0f));
+  const MapFeatures f = describeAtDecimetre(storeys);
+  ASSERT_EQ(f.occupancy.seen.size(), f.occupancy.cells.size());
+  ASSERT_GT(std::count(f.occupancy.seen.begin(), f.occupancy.seen.end(), false), 0);
+  const MapOffer offer = makeOffer("alpha", f, {}, 1000000, 4000);
+  EXPECT_FALSE(validate(offer.announcement)) << validate(offer.announcement).text();
+  const Reassembler r = receiveAll(offer, /*shuffle=*/false);
+  ASSERT_TRUE(r.complete());
+  EXPECT_EQ(r.build().occupancy.seen, f.occupancy.seen);
+
+  const auto lie = [&](std::vector<int32_t> unseen) {
+    wire::MapAnnouncement a = offer.announcement;
+    a.unseen(std::move(unseen));
+    a.version(mapVersion(a));
+    return validate(a);
+  };
+  const int32_t sent = offer.announcement.slices().front().slice(), count = offer.announcement.slice_count();
+  EXPECT_EQ(lie({sent}), Reject::BadUnseen) << "not in pairs";
+  EXPECT_EQ(lie({sent, sent}), Reject::BadUnseen) << "over a slice it sends";
+  EXPECT_EQ(lie({count, count}), Reject::BadUnseen) << "out of range";
+  EXPECT_EQ(lie({-1, -1}), Reject::BadUnseen) << "out of range";
+  EXPECT_EQ(lie({1, 0}), Reject::BadUnseen) << "a run upside down";
+  EXPECT_EQ(lie({}), Reject::None) << "saying nothing: every height seen";
+}
+
 TEST(SliceCodec, ALevelledMapSaysItsUpAndTheReceiverUndoesItsLevelling) {
   // The map as a SLAM saved it, its first frame leaning 8 degrees: levelled before slicing.
   const Eigen::Quaterniond lean(Eigen::AngleAxisd(radians(8), Eigen::Vector3d(1, 2, 0).normalized()));

@@ -98,6 +98,31 @@ TEST(Slices, ASparseSliceIsKeptButNotAmongTheFullSlices) {
   EXPECT_EQ(full.cells[10], s.cells[10]);
 }
 
+// A height where the map had no point was not seen (a slab between two
+// floors); one with too few points to describe was: the empty space a pose
+// is judged on reads the difference (dense_search.cpp, Enclosure). Slicing,
+// pooling and keeping the full slices carry it along.
+TEST(Slices, AHeightWithNoPointIsUnseenWhereASparseOneIsSeen) {
+  Points pts = room(0.05);
+  for (double x = 0; x <= 1.2; x += 0.05) pts.emplace_back(x, 1.5, 3.4);  // rails, as above
+  for (double x = 0; x <= 1.2; x += 0.05) pts.emplace_back(x, 1.7, 3.4);
+  pts.emplace_back(1.0f, 1.0f, 3.0f);  // a lone point: too sparse to describe
+  const SliceStack s = makeSlices(pts, 0.1);
+  ASSERT_EQ(s.size(), 35);
+  ASSERT_EQ(s.seen.size(), s.cells.size());
+  EXPECT_TRUE(s.seen[10]);
+  EXPECT_TRUE(s.cells[30].empty());
+  EXPECT_TRUE(s.seen[30]);
+  EXPECT_FALSE(s.seen[28]);
+  const SliceStack p = pooled(s);
+  ASSERT_EQ(p.seen.size(), p.cells.size());
+  EXPECT_TRUE(p.seen[15]);   // fine slices 30 and 31
+  EXPECT_FALSE(p.seen[14]);  // 28 and 29
+  const SliceStack full = fullSlices(s);
+  ASSERT_EQ(full.size(), 26);
+  EXPECT_EQ(full.seen, std::vector<bool>(s.seen.begin(), s.seen.begin() + 26));
+}
+
 TEST(Slices, TooFineGridFailsLoudly) {
   const Points pts{{0, 0, 0}, {1000, 1000, 1}};
   EXPECT_THROW(makeSlices(pts, 0.01), InputError);
