@@ -89,9 +89,27 @@ std::vector<Cell> cellsOf(const SliceStack& s, double wall_spread) {
 class Enclosure {
  public:
   explicit Enclosure(const SliceStack& s)
-      : first_(static_cast<size_t>(s.grid.width) * static_cast<size_t>(s.grid.height) + 1, 0),
+      : lowest_(static_cast<size_t>(s.grid.width) * static_cast<size_t>(s.grid.height), UINT16_MAX),
+        highest_(lowest_.size(), 0),
         storey_(static_cast<size_t>(s.size())) {
-    // Each column's occupied slices, ascending (a counting sort by pixel).
+    // Slices are fewer than kMaxImageSide: they fit 16 bits.
+    for (int k = 0; k < s.size(); ++k)
+      for (uint32_t idx : s.cells[static_cast<size_t>(k)]) {
+        lowest_[idx] = std::min(lowest_[idx], static_cast<uint16_t>(k));
+        highest_[idx] = static_cast<uint16_t>(k);
+      }
+    const auto seen = [&](int k) { return s.seen.empty() || s.seen[static_cast<size_t>(k)]; };
+    int storeys = 0;
+    for (int k = 0; k < s.size(); ++storeys) {
+      int end = k;
+      while (seen(end) && end + 1 < s.size() && seen(end + 1)) ++end;
+      for (int i = k; i <= end; ++i) storey_[static_cast<size_t>(i)] = {k, end};
+      k = end + 1;
+    }
+    if (storeys < 2) return;
+    // Each column's occupied slices, ascending (a counting sort by pixel): a
+    // column that reaches past a storey is looked up in them.
+    first_.assign(lowest_.size() + 1, 0);
     for (const auto& cells : s.cells)
       for (uint32_t idx : cells) ++first_[idx + 1];
     for (size_t p = 1; p < first_.size(); ++p) first_[p] += first_[p - 1];
@@ -99,30 +117,28 @@ class Enclosure {
     std::vector<uint32_t> next(first_.begin(), first_.end() - 1);
     for (int k = 0; k < s.size(); ++k)
       for (uint32_t idx : s.cells[static_cast<size_t>(k)]) slices_[next[idx]++] = static_cast<uint16_t>(k);
-    const auto seen = [&](int k) { return s.seen.empty() || s.seen[static_cast<size_t>(k)]; };
-    for (int k = 0; k < s.size();) {
-      int end = k;
-      while (seen(end) && end + 1 < s.size() && seen(end + 1)) ++end;
-      for (int i = k; i <= end; ++i) storey_[static_cast<size_t>(i)] = {k, end};
-      k = end + 1;
-    }
   }
   /// Whether pixel `idx` of slice `k` lies between occupancy below and above in its storey.
   bool encloses(int idx, int k) const {
-    const auto [lowest, highest] = storey_[static_cast<size_t>(k)];
-    const auto begin = slices_.begin() + first_[static_cast<size_t>(idx)],
-               end = slices_.begin() + first_[static_cast<size_t>(idx) + 1];
+    const auto p = static_cast<size_t>(idx);
+    if (lowest_[p] > k - kMargin || highest_[p] < k + kMargin) return false;  // not even by the whole column
+    const auto [bottom, top] = storey_[static_cast<size_t>(k)];
+    if (lowest_[p] >= bottom && highest_[p] <= top) return true;  // the whole column lies in k's storey
+    const auto begin = slices_.begin() + first_[p], end = slices_.begin() + first_[p + 1];
     const auto above = std::lower_bound(begin, end, k + kMargin);
-    if (above == end || *above > highest) return false;
+    if (above == end || *above > top) return false;
     const auto below = std::upper_bound(begin, end, k - kMargin);
-    return below != begin && *(below - 1) >= lowest;
+    return below != begin && *(below - 1) >= bottom;
   }
 
  private:
   static constexpr int kMargin = 2;          ///< [slices]
-  std::vector<uint32_t> first_;              ///< per pixel, where its column starts in slices_ (and one past the last)
-  std::vector<uint16_t> slices_;             ///< each column's occupied slices, ascending
+  std::vector<uint16_t> lowest_, highest_;   ///< per pixel, its column's lowest and highest occupied slice
   std::vector<std::pair<int, int>> storey_;  ///< per slice, its storey's lowest and highest slice
+  /// With more than one storey: per pixel, where its column starts in slices_
+  /// (and one past the last), and each column's occupied slices, ascending.
+  std::vector<uint32_t> first_;
+  std::vector<uint16_t> slices_;
 };
 
 /// The packed real spectrum (OpenCV's CCS) of a coarse binary `image`
