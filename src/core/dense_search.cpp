@@ -91,32 +91,19 @@ class Enclosure {
   explicit Enclosure(const SliceStack& s)
       : lowest_(static_cast<size_t>(s.grid.width) * static_cast<size_t>(s.grid.height), UINT16_MAX),
         highest_(lowest_.size(), 0),
-        storey_(static_cast<size_t>(s.size())) {
-    // Slices are fewer than kMaxImageSide: they fit 16 bits.
+        storey_(storeysOf(s)) {
+    // A stack has at most kMaxImageSide slices (makeSlices; transport's
+    // validate for a peer's): they fit 16 bits.
     for (int k = 0; k < s.size(); ++k)
       for (uint32_t idx : s.cells[static_cast<size_t>(k)]) {
         lowest_[idx] = std::min(lowest_[idx], static_cast<uint16_t>(k));
         highest_[idx] = static_cast<uint16_t>(k);
       }
-    const auto seen = [&](int k) { return s.seen.empty() || s.seen[static_cast<size_t>(k)]; };
-    int storeys = 0;
-    for (int k = 0; k < s.size(); ++storeys) {
-      int end = k;
-      while (seen(end) && end + 1 < s.size() && seen(end + 1)) ++end;
-      for (int i = k; i <= end; ++i) storey_[static_cast<size_t>(i)] = {k, end};
-      k = end + 1;
-    }
-    if (storeys < 2) return;
-    // Each column's occupied slices, ascending (a counting sort by pixel): a
-    // column that reaches past a storey is looked up in them.
-    first_.assign(lowest_.size() + 1, 0);
-    for (const auto& cells : s.cells)
-      for (uint32_t idx : cells) ++first_[idx + 1];
-    for (size_t p = 1; p < first_.size(); ++p) first_[p] += first_[p - 1];
-    slices_.resize(first_.back());
-    std::vector<uint32_t> next(first_.begin(), first_.end() - 1);
     for (int k = 0; k < s.size(); ++k)
-      for (uint32_t idx : s.cells[static_cast<size_t>(k)]) slices_[next[idx]++] = static_cast<uint16_t>(k);
+      if (!s.seenAt(k)) {
+        indexColumns(s);
+        break;
+      }
   }
   /// Whether pixel `idx` of slice `k` lies between occupancy below and above in its storey.
   bool encloses(int idx, int k) const {
@@ -132,6 +119,31 @@ class Enclosure {
   }
 
  private:
+  /// Per slice, the lowest and highest slice of its storey: the run of seen
+  /// slices around it (an unseen slice is a storey of its own, enclosing nothing).
+  static std::vector<std::pair<int, int>> storeysOf(const SliceStack& s) {
+    std::vector<std::pair<int, int>> out(static_cast<size_t>(s.size()));
+    for (int k = 0; k < s.size();) {
+      int end = k;
+      while (s.seenAt(end) && end + 1 < s.size() && s.seenAt(end + 1)) ++end;
+      for (int i = k; i <= end; ++i) out[static_cast<size_t>(i)] = {k, end};
+      k = end + 1;
+    }
+    return out;
+  }
+  /// first_ and slices_, for a map with more than one storey: a column that
+  /// reaches past a storey is looked up in its slices (a counting sort by pixel).
+  void indexColumns(const SliceStack& s) {
+    first_.assign(lowest_.size() + 1, 0);
+    for (const auto& cells : s.cells)
+      for (uint32_t idx : cells) ++first_[idx + 1];
+    for (size_t p = 1; p < first_.size(); ++p) first_[p] += first_[p - 1];
+    slices_.resize(first_.back());
+    std::vector<uint32_t> next(first_.begin(), first_.end() - 1);
+    for (int k = 0; k < s.size(); ++k)
+      for (uint32_t idx : s.cells[static_cast<size_t>(k)]) slices_[next[idx]++] = static_cast<uint16_t>(k);
+  }
+
   static constexpr int kMargin = 2;          ///< [slices]
   std::vector<uint16_t> lowest_, highest_;   ///< per pixel, its column's lowest and highest occupied slice
   std::vector<std::pair<int, int>> storey_;  ///< per slice, its storey's lowest and highest slice

@@ -44,10 +44,14 @@ void trimEnds(SliceStack& stack) {
     stack.seen.clear();
     return;
   }
-  const auto lowest = first - cells.begin(), highest = last - cells.begin();
+  const auto lowest = first - cells.begin(), end = last - cells.begin();
   stack.grid.z_min = stack.grid.sliceHeight(static_cast<int>(lowest));
   cells = std::vector<std::vector<uint32_t>>(std::make_move_iterator(first), std::make_move_iterator(last));
-  if (!stack.seen.empty()) stack.seen = std::vector<bool>(stack.seen.begin() + lowest, stack.seen.begin() + highest);
+  if (!stack.seen.empty()) {
+    std::vector<bool> kept;
+    for (auto k = lowest; k < end; ++k) kept.push_back(stack.seenAt(static_cast<int>(k)));
+    stack.seen = std::move(kept);
+  }
 }
 
 }  // namespace
@@ -175,7 +179,8 @@ SliceStack pooled(const SliceStack& fine) {
     for (uint32_t idx : fine.cells[k]) out.cells[k / 2].push_back(idx / w / 2 * W + idx % w / 2);
   if (!fine.seen.empty()) {
     out.seen.assign(out.cells.size(), false);
-    for (size_t k = 0; k < fine.seen.size(); ++k) out.seen[k / 2] = out.seen[k / 2] || fine.seen[k];
+    for (int k = 0; k < fine.size(); ++k)
+      out.seen[static_cast<size_t>(k) / 2] = out.seen[static_cast<size_t>(k) / 2] || fine.seenAt(k);
   }
   for (auto& c : out.cells) {
     std::sort(c.begin(), c.end());

@@ -46,14 +46,17 @@ struct SliceStack {
   SliceGrid grid;
   std::vector<std::vector<uint32_t>> cells;  ///< per slice; empty = too sparse to describe (kSparsestSlice)
   /// Per slice, whether the map had any point at its height: a slice too
-  /// sparse to describe was seen, a slab between two floors was not. Empty
-  /// where not known (a stack that crossed the network): every slice seen.
+  /// sparse to describe was seen, a slab between two floors was not (the
+  /// empty space a pose is judged on reads the difference: dense_search.cpp,
+  /// Enclosure). Empty where not known: every slice seen (seenAt).
   std::vector<bool> seen{};
   size_t stray = 0;  ///< points left out as stray returns (map_bounds.hpp)
   /// Some slices' cells are not here: they crossed the network as features.
   bool partial = false;
 
   int size() const { return static_cast<int>(cells.size()); }
+  /// Whether slice k was seen: a slice `seen` does not cover counts as seen.
+  bool seenAt(int k) const { return static_cast<size_t>(k) >= seen.size() || seen[static_cast<size_t>(k)]; }
   /// Slices with cells (the others are too sparse to describe).
   int occupiedSlices() const {
     return static_cast<int>(std::count_if(cells.begin(), cells.end(), [](const auto& c) { return !c.empty(); }));

@@ -34,13 +34,13 @@ bool acceptable(const wire::FeatureSettings& fs) {
   return features.inRange(fs.max_features()) && fast.inRange(fs.fast_threshold()) && fs.pad() <= kMaxPad;
 }
 
-/// The runs of slices at whose height the map had no point
-/// (SliceStack::seen), each its first and last slice, as the announcement
-/// carries them: the lowest wire::MAX_SLICES / 2 runs (of a map with more, a
-/// receiver reads the rest as seen, as it reads a stack that does not say).
+/// The runs of unseen slices (SliceStack::seen), each its first and last
+/// slice, as the announcement carries them: the lowest wire::MAX_UNSEEN / 2
+/// runs (of a map with more, a receiver reads the rest as seen, as it reads
+/// a stack that does not say).
 std::vector<int32_t> unseenRuns(const std::vector<bool>& seen) {
   std::vector<int32_t> runs;
-  for (size_t k = 0; k < seen.size() && runs.size() + 2 <= wire::MAX_SLICES; ++k) {
+  for (size_t k = 0; k < seen.size() && runs.size() + 2 <= wire::MAX_UNSEEN; ++k) {
     if (seen[k]) continue;
     size_t last = k;
     while (last + 1 < seen.size() && !seen[last + 1]) ++last;
@@ -219,8 +219,8 @@ std::set<int> unchangedSlices(const wire::MapAnnouncement& now, const wire::MapA
 }
 
 uint64_t mapVersion(const wire::MapAnnouncement& a) {
-  // FNV-1a over the raster geometry, the feature settings and every slice's
-  // index, CRC and part count: the same content cut for another bandwidth
+  // FNV-1a over the raster geometry, the feature settings, every slice's
+  // index, CRC and part count and the unseen runs: the same content cut for another bandwidth
   // budget (a reload) is another version, so a receiver never mixes parts of
   // two chunkings.
   uint64_t h = 1469598103934665603ull;
@@ -276,7 +276,8 @@ Rejection validate(const wire::MapAnnouncement& a) {
   if (!levelableUp(upOf(a))) return {Reject::BadUp};
   if (a.width() == 0 || a.height() == 0 || a.width() > kMaxImageSide || a.height() > kMaxImageSide)
     return {Reject::BadRaster};
-  if (a.slice_count() <= 0 || a.slice_count() > 100000) return {Reject::BadSliceCount};
+  // No more slices than makeSlices makes: their indices fit 16 bits where a pose is judged.
+  if (a.slice_count() <= 0 || a.slice_count() > kMaxImageSide) return {Reject::BadSliceCount};
   const auto& fs = a.features();
   if (!acceptable(fs)) return {Reject::BadFeatureSettings};
   // A slice can never need more than its deflated raster or its announced features.

@@ -168,12 +168,20 @@ TEST(SliceCodec, TheHeightsAMapSawNothingAtTravelWithIt) {
     return validate(a);
   };
   const int32_t sent = offer.announcement.slices().front().slice(), count = offer.announcement.slice_count();
+  ASSERT_GE(offer.announcement.unseen().size(), 2u);
+  const int32_t gap = offer.announcement.unseen().front();  // the slab's lowest slice
+  EXPECT_EQ(lie({gap, gap, gap + 2, gap + 2}), Reject::None) << "two runs, apart";
+  EXPECT_EQ(lie({gap, gap, gap + 1, gap + 1}), Reject::BadUnseen) << "two runs that are one";
+  EXPECT_EQ(lie({gap + 2, gap + 2, gap, gap}), Reject::BadUnseen) << "out of order";
   EXPECT_EQ(lie({sent}), Reject::BadUnseen) << "not in pairs";
   EXPECT_EQ(lie({sent, sent}), Reject::BadUnseen) << "over a slice it sends";
   EXPECT_EQ(lie({count, count}), Reject::BadUnseen) << "out of range";
   EXPECT_EQ(lie({-1, -1}), Reject::BadUnseen) << "out of range";
   EXPECT_EQ(lie({1, 0}), Reject::BadUnseen) << "a run upside down";
   EXPECT_EQ(lie({}), Reject::None) << "saying nothing: every height seen";
+  wire::MapAnnouncement a = offer.announcement;  // other runs under the old version
+  a.unseen({gap, gap});
+  EXPECT_EQ(validate(a), Reject::VersionMismatch);
 }
 
 TEST(SliceCodec, ALevelledMapSaysItsUpAndTheReceiverUndoesItsLevelling) {

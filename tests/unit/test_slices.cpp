@@ -106,21 +106,23 @@ TEST(Slices, AHeightWithNoPointIsUnseenWhereASparseOneIsSeen) {
   Points pts = room(0.05);
   for (double x = 0; x <= 1.2; x += 0.05) pts.emplace_back(x, 1.5, 3.4);  // rails, as above
   for (double x = 0; x <= 1.2; x += 0.05) pts.emplace_back(x, 1.7, 3.4);
-  pts.emplace_back(1.0f, 1.0f, 3.0f);  // a lone point: too sparse to describe
+  pts.emplace_back(1.0f, 1.0f, 3.0f);   // a lone point: too sparse to describe
+  pts.emplace_back(1.0f, 1.0f, -0.5f);  // another below the floor, trimmed away with the heights between
   const SliceStack s = makeSlices(pts, 0.1);
   ASSERT_EQ(s.size(), 35);
-  ASSERT_EQ(s.seen.size(), s.cells.size());
-  EXPECT_TRUE(s.seen[10]);
-  EXPECT_TRUE(s.cells[30].empty());
-  EXPECT_TRUE(s.seen[30]);
-  EXPECT_FALSE(s.seen[28]);
+  EXPECT_NEAR(s.grid.z_min, 0.0, 1e-6);
+  std::vector<bool> expected(35, false);  // the room to its ceiling, the lone point and the rails
+  for (int k = 0; k <= 25; ++k) expected[static_cast<size_t>(k)] = true;
+  expected[30] = expected[34] = true;
+  EXPECT_EQ(s.seen, expected);
+  EXPECT_TRUE(s.cells[30].empty()) << "seen, not described";
   const SliceStack p = pooled(s);
   ASSERT_EQ(p.seen.size(), p.cells.size());
   EXPECT_TRUE(p.seen[15]);   // fine slices 30 and 31
   EXPECT_FALSE(p.seen[14]);  // 28 and 29
   const SliceStack full = fullSlices(s);
   ASSERT_EQ(full.size(), 26);
-  EXPECT_EQ(full.seen, std::vector<bool>(s.seen.begin(), s.seen.begin() + 26));
+  EXPECT_EQ(full.seen, std::vector<bool>(26, true));
 }
 
 TEST(Slices, TooFineGridFailsLoudly) {
