@@ -99,11 +99,8 @@ class Enclosure {
         lowest_[idx] = std::min(lowest_[idx], static_cast<uint16_t>(k));
         highest_[idx] = static_cast<uint16_t>(k);
       }
-    for (int k = 0; k < s.size(); ++k)
-      if (!s.seenAt(k)) {
-        indexColumns(s);
-        break;
-      }
+    // Only a column of a map of more than one storey may reach past its own.
+    if (!storey_.empty() && storey_.front().second + 1 < s.size()) indexColumns(s);
   }
   /// Whether pixel `idx` of slice `k` lies between occupancy below and above in its storey.
   bool encloses(int idx, int k) const {
@@ -123,12 +120,9 @@ class Enclosure {
   /// slices around it (an unseen slice is a storey of its own, enclosing nothing).
   static std::vector<std::pair<int, int>> storeysOf(const SliceStack& s) {
     std::vector<std::pair<int, int>> out(static_cast<size_t>(s.size()));
-    for (int k = 0; k < s.size();) {
-      int end = k;
-      while (s.seenAt(end) && end + 1 < s.size() && s.seenAt(end + 1)) ++end;
-      for (int i = k; i <= end; ++i) out[static_cast<size_t>(i)] = {k, end};
-      k = end + 1;
-    }
+    for (const SliceRun& run : seenRuns(s))
+      for (int k = run.first; k <= run.last; ++k)
+        out[static_cast<size_t>(k)] = run.seen ? std::pair{run.first, run.last} : std::pair{k, k};
     return out;
   }
   /// first_ and slices_, for a map with more than one storey: a column that

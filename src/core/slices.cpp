@@ -189,4 +189,14 @@ SliceStack pooled(const SliceStack& fine) {
   return out;
 }
 
+std::vector<SliceRun> seenRuns(const SliceStack& stack) {
+  std::vector<SliceRun> out;
+  for (int k = 0; k < stack.size(); ++k)
+    if (out.empty() || out.back().seen != stack.seenAt(k))
+      out.push_back({k, k, stack.seenAt(k)});
+    else
+      out.back().last = k;
+  return out;
+}
+
 }  // namespace tomomap

@@ -114,4 +114,13 @@ SliceStack fullSlices(const SliceStack& stack);
 /// above slice 2k's: an offset of K pooled slices is 2K fine ones.
 SliceStack pooled(const SliceStack& fine);
 
+/// A run of neighbouring slices alike in being seen or not (SliceStack::seenAt).
+struct SliceRun {
+  int first = 0, last = 0;  ///< its lowest and highest slice [slices]
+  bool seen = true;
+};
+
+/// `stack`'s slices as runs of seen and unseen ones, lowest first.
+std::vector<SliceRun> seenRuns(const SliceStack& stack);
+
 }  // namespace tomomap

@@ -38,16 +38,10 @@ bool acceptable(const wire::FeatureSettings& fs) {
 /// slice, as the announcement carries them: the lowest wire::MAX_UNSEEN / 2
 /// runs (of a map with more, a receiver reads the rest as seen, as it reads
 /// a stack that does not say).
-std::vector<int32_t> unseenRuns(const std::vector<bool>& seen) {
+std::vector<int32_t> unseenRuns(const SliceStack& stack) {
   std::vector<int32_t> runs;
-  for (size_t k = 0; k < seen.size() && runs.size() + 2 <= wire::MAX_UNSEEN; ++k) {
-    if (seen[k]) continue;
-    size_t last = k;
-    while (last + 1 < seen.size() && !seen[last + 1]) ++last;
-    runs.push_back(static_cast<int32_t>(k));
-    runs.push_back(static_cast<int32_t>(last));
-    k = last;
-  }
+  for (const SliceRun& run : seenRuns(stack))
+    if (!run.seen && runs.size() + 2 <= wire::MAX_UNSEEN) runs.insert(runs.end(), {run.first, run.last});
   return runs;
 }
 
@@ -112,7 +106,7 @@ MapOffer makeOffer(const std::string& agent, const MapFeatures& f, const Feature
   a.width(static_cast<uint16_t>(g.width));
   a.height(static_cast<uint16_t>(g.height));
   a.slice_count(f.slice_count);
-  a.unseen(unseenRuns(f.occupancy.seen));
+  a.unseen(unseenRuns(f.occupancy));
   a.raw_bytes(raw_bytes);
   a.features().max_features(static_cast<uint16_t>(params.max_features));
   a.features().fast_threshold(static_cast<uint16_t>(params.fast_threshold));

@@ -174,6 +174,7 @@ TEST(SliceCodec, TheHeightsAMapSawNothingAtTravelWithIt) {
   EXPECT_EQ(lie({gap, gap, gap + 1, gap + 1}), Reject::BadUnseen) << "two runs that are one";
   EXPECT_EQ(lie({gap + 2, gap + 2, gap, gap}), Reject::BadUnseen) << "out of order";
   EXPECT_EQ(lie({sent}), Reject::BadUnseen) << "not in pairs";
+  EXPECT_EQ(lie({sent}).text(), "announcement with an unseen run without its last slice");
   EXPECT_EQ(lie({sent, sent}), Reject::BadUnseen) << "over a slice it sends";
   EXPECT_EQ(lie({count, count}), Reject::BadUnseen) << "out of range";
   EXPECT_EQ(lie({-1, -1}), Reject::BadUnseen) << "out of range";

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <tuple>
 
 #include "core/slices.hpp"
 
@@ -116,6 +117,12 @@ TEST(Slices, AHeightWithNoPointIsUnseenWhereASparseOneIsSeen) {
   expected[30] = expected[34] = true;
   EXPECT_EQ(s.seen, expected);
   EXPECT_TRUE(s.cells[30].empty()) << "seen, not described";
+  const std::vector<SliceRun> runs = seenRuns(s);  // the same, as runs
+  ASSERT_EQ(runs.size(), 5u);
+  const std::vector<std::tuple<int, int, bool>> expected_runs = {
+      {0, 25, true}, {26, 29, false}, {30, 30, true}, {31, 33, false}, {34, 34, true}};
+  for (size_t i = 0; i < runs.size(); ++i)
+    EXPECT_EQ(std::tuple(runs[i].first, runs[i].last, runs[i].seen), expected_runs[i]) << "run " << i;
   const SliceStack p = pooled(s);
   ASSERT_EQ(p.seen.size(), p.cells.size());
   EXPECT_TRUE(p.seen[15]);   // fine slices 30 and 31
