@@ -70,7 +70,8 @@ const char* onName(CandidateVerdict::On on);
 /// one that lands the most, leads its next by kBars.dense_lead beyond chance
 /// over min_support slices, no search's best pose elsewhere leads its next
 /// so, and that search's second look finds it again (asked for by
-/// needs_look).
+/// needs_look). At the place the first three answer, the pose answered is
+/// the candidate there that lands the most on the maps' own cells, unpooled.
 CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, const MatchParams& params, double grid,
                                     const Eigen::Vector2d& source_centre, const std::vector<SearchLead>& searches);
 

@@ -133,6 +133,28 @@ TEST(CandidateDecision, WhereTheOccupancyDoesNotTellTheFeaturesVotesDoUnlessItTe
   EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
 }
 
+// On maps finer than 0.1 m the place is judged on pooled occupancy, which
+// reads empty space but not a pose a cell or two off; the pose answered is
+// the one at that place that lands the most on the maps' own cells.
+TEST(CandidateDecision, AtItsPlaceThePoseAnsweredLandsTheMostOnTheMapsOwnCells) {
+  const MatchParams p = atTenCentimetres();
+  const auto pooledAs = [](Candidate fine, const Candidate& pooled) {
+    fine.pooled_slices = pooled.slices;
+    return fine;
+  };
+  std::vector<Candidate> c{// lands the most pooled; two cells off, so less on its own cells
+                           pooledAs(landing(0.1, 0, 0, 40, {40, 45}), landing(0.1, 0, 0, 20, {70, 75})),
+                           pooledAs(landing(0, 0, 0, 40, {60, 65}), landing(0, 0, 0, 20, {68, 74})),  // the same place
+                           pooledAs(landing(5, 0, 0, 40, {20, 25}), landing(5, 0, 0, 20, {30, 35}))};
+  const CandidateVerdict v = decideOnCandidates(c, p, 0.05, Eigen::Vector2d::Zero(), {});
+  ASSERT_EQ(v.answer, 1) << v.reason;
+  EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
+  EXPECT_EQ(v.slices, 20) << "the place's lead, on the pooled slices";
+  // Unpooled (0.1 m and coarser) the best answers as it lands.
+  for (Candidate& k : c) k.slices = k.pooled_slices, k.pooled_slices.clear();
+  EXPECT_EQ(decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {}).answer, 0);
+}
+
 TEST(CandidateDecision, EmptySpaceTheOtherMapSawCountsAgainstAPose) {
   const MatchParams p = atTenCentimetres();
   // The half-turned room lands more cells but twice as many of its cells in space the target saw empty.
