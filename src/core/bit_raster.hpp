@@ -43,6 +43,13 @@ class BitRaster {
   }
 
   bool empty() const { return words_.empty(); }
+  /// Calls f(idx) for every set pixel, in order; none on an empty raster.
+  template <typename F>
+  void forEachSet(F&& f) const {
+    for (size_t w = 0; w < words_.size(); ++w)
+      for (uint64_t bits = words_[w]; bits != 0; bits &= bits - 1)
+        f(w * 64 + static_cast<size_t>(__builtin_ctzll(bits)));
+  }
   /// Whether pixel `idx` (v * width + u) is set; the raster must not be empty.
   bool test(size_t idx) const { return (words_[idx / 64] >> (idx % 64)) & 1U; }
   /// Every pixel set in `other` (a raster of the same size) set here too.
@@ -79,6 +86,34 @@ class BitRaster {
 
   int width_ = 0, height_ = 0;
   std::vector<uint64_t> words_;
+};
+
+/// A stack of rasters of one size read down its columns: per pixel, a bit
+/// per raster. Choosing a pose's height tests each cell of it on every
+/// slice within reach; down a column those are one or two words, where the
+/// rasters were a word each (dense_search.cpp, mostInliersAt).
+class BitColumns {
+ public:
+  BitColumns() = default;
+  /// The columns of `rasters` (each empty or of `pixels` pixels).
+  BitColumns(const std::vector<BitRaster>& rasters, size_t pixels)
+      : words_((rasters.size() + 63) / 64), bits_(pixels * words_, 0) {
+    for (size_t k = 0; k < rasters.size(); ++k)
+      rasters[k].forEachSet([&](size_t idx) { bits_[idx * words_ + k / 64] |= uint64_t{1} << (k % 64); });
+  }
+  /// Rasters first to first + count - 1 at pixel `idx`, raster `first` in
+  /// bit 0: 0 <= first, first + count <= the rasters' number, 1 <= count <= 64.
+  uint64_t window(size_t idx, int first, int count) const {
+    const uint64_t* column = &bits_[idx * words_];
+    const auto word = static_cast<size_t>(first) / 64, bit = static_cast<size_t>(first) % 64;
+    uint64_t out = column[word] >> bit;
+    if (bit != 0 && word + 1 < words_) out |= column[word + 1] << (64 - bit);
+    return count == 64 ? out : out & ((uint64_t{1} << count) - 1);
+  }
+
+ private:
+  size_t words_ = 0;  ///< per column
+  std::vector<uint64_t> bits_;
 };
 
 }  // namespace tomomap

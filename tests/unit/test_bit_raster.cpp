@@ -84,3 +84,27 @@ TEST(BitRaster, NoCellsKeepNoWordsAndAddingIsTheUnion) {
   for (uint32_t p = 0; p < static_cast<uint32_t>(g.width * g.height); ++p)
     ASSERT_EQ(both.test(p), either.count(p) == 1) << "pixel " << p;
 }
+
+// Choosing a pose's height reads a window of slices down a pixel's column:
+// it must read each raster's own bit, across the words a column spans (130
+// rasters: three words), and none where a raster is empty.
+TEST(BitColumns, AWindowDownAColumnReadsEachRastersOwnPixel) {
+  const SliceGrid g = oddGrid();
+  std::vector<BitRaster> rasters;
+  for (unsigned k = 0; k < 130; ++k)
+    rasters.push_back(k % 17 == 5 ? BitRaster() : BitRaster(g, randomCells(g, 300 + static_cast<int>(k), k)));
+  const size_t pixels = static_cast<size_t>(g.width) * static_cast<size_t>(g.height);
+  const BitColumns columns(rasters, pixels);
+  size_t set = 0;
+  for (size_t idx = 0; idx < pixels; idx += 7)
+    for (const auto& [first, count] : {std::pair{0, 64}, std::pair{0, 1}, std::pair{60, 11}, std::pair{64, 64},
+                                       std::pair{66, 64}, std::pair{125, 5}, std::pair{119, 11}}) {
+      uint64_t expected = 0;
+      for (int k = 0; k < count; ++k)
+        if (const BitRaster& r = rasters[static_cast<size_t>(first + k)]; !r.empty() && r.test(idx))
+          expected |= uint64_t{1} << k;
+      ASSERT_EQ(columns.window(idx, first, count), expected) << "pixel " << idx << " from " << first;
+      set += expected != 0;
+    }
+  EXPECT_GT(set, 1000u) << "the windows read something";
+}
