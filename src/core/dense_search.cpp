@@ -272,7 +272,7 @@ constexpr std::array<uint64_t, 16> kNibbleLanes = [] {
 /// in one pass over the cells: choosing a height needs the inliers alone,
 /// not the rest of a tally. A cell's offsets are one window down its
 /// column, counted four offsets to a word (kNibbleLanes): on the slowest
-/// matrix pair that took a third of testing each offset's slice in turn.
+/// matrix pair that took half the time of testing each offset's slice in turn.
 int mostInliersAt(const BitColumns& dilated, int slices, const std::vector<Cell>& cells,
                   const std::vector<int>& landing, int lowest, int count, std::optional<int> preferred = {}) {
   if (count < 1 || count > 64) throw std::logic_error("mostInliersAt: 1 to 64 offsets at a time");
