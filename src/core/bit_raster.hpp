@@ -91,18 +91,21 @@ class BitRaster {
 /// A stack of rasters of one size read down its columns: per pixel, a bit
 /// per raster. Choosing a pose's height tests each cell of it on every
 /// slice within reach; down a column those are one or two words, where the
-/// rasters were a word each (dense_search.cpp, mostInliersAt).
+/// rasters are a word each (dense_search.cpp, mostInliersAt). It takes a
+/// word per pixel per 64 rasters, whatever they hold: for the small maps a
+/// dense search searches, not for every stack.
 class BitColumns {
  public:
   BitColumns() = default;
   /// The columns of `rasters` (each empty or of `pixels` pixels).
   BitColumns(const std::vector<BitRaster>& rasters, size_t pixels)
-      : words_((rasters.size() + 63) / 64), bits_(pixels * words_, 0) {
+      : rasters_(static_cast<int>(rasters.size())), words_((rasters.size() + 63) / 64), bits_(pixels * words_, 0) {
     for (size_t k = 0; k < rasters.size(); ++k)
       rasters[k].forEachSet([&](size_t idx) { bits_[idx * words_ + k / 64] |= uint64_t{1} << (k % 64); });
   }
   /// Rasters first to first + count - 1 at pixel `idx`, raster `first` in
   /// bit 0: 0 <= first, first + count <= the rasters' number, 1 <= count <= 64.
+  int size() const { return rasters_; }  ///< the rasters'
   uint64_t window(size_t idx, int first, int count) const {
     const uint64_t* column = &bits_[idx * words_];
     const auto word = static_cast<size_t>(first) / 64, bit = static_cast<size_t>(first) % 64;
@@ -112,6 +115,7 @@ class BitColumns {
   }
 
  private:
+  int rasters_ = 0;
   size_t words_ = 0;  ///< per column
   std::vector<uint64_t> bits_;
 };

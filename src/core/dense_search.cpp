@@ -264,33 +264,52 @@ constexpr std::array<uint64_t, 16> kNibbleLanes = [] {
   return out;
 }();
 
+/// A stack of dilated slices as mostInliersAt reads it, a window of slices
+/// down a pixel's column, each slice tested in turn (BitColumns::window).
+struct SliceWindows {
+  const std::vector<BitRaster>& slices;
+  int size() const { return static_cast<int>(slices.size()); }
+  uint64_t window(size_t idx, int first, int count) const {
+    uint64_t out = 0;
+    for (int k = 0; k < count; ++k)
+      if (const BitRaster& s = slices[static_cast<size_t>(first + k)]; !s.empty() && s.test(idx))
+        out |= uint64_t{1} << k;
+    return out;
+  }
+};
+
 /// The height offset from `lowest` to `lowest + count - 1` (1 <= count <=
 /// 64) at which most of the source `cells`, landed at `landing`, fall on a
-/// dilated target cell (`dilated`, the target's `slices` dilated slices by
-/// column; countInliers' inliers; the first of the most, or `preferred`, an
-/// offset in that range, where it is among them), counted for every offset
-/// in one pass over the cells: choosing a height needs the inliers alone,
-/// not the rest of a tally. A cell's offsets are one window down its
-/// column, counted four offsets to a word (kNibbleLanes): on the slowest
-/// matrix pair that took half the time of testing each offset's slice in turn.
-int mostInliersAt(const BitColumns& dilated, int slices, const std::vector<Cell>& cells,
-                  const std::vector<int>& landing, int lowest, int count, std::optional<int> preferred = {}) {
+/// dilated target cell (`dilated`: SliceWindows or BitColumns of the
+/// target's dilated slices; countInliers' inliers; the first of the most,
+/// or `preferred`, an offset in that range, where it is among them),
+/// counted for every offset in one pass over the cells: choosing a height
+/// needs the inliers alone, not the rest of a tally.
+///
+/// A cell's offsets are one window down its column, counted four offsets
+/// to a word (kNibbleLanes). A dense search reads its windows off
+/// BitColumns: on the slowest matrix pair that took half the time of
+/// testing each offset's slice in turn.
+template <typename Columns>
+int mostInliersAt(const Columns& dilated, const std::vector<Cell>& cells, const std::vector<int>& landing, int lowest,
+                  int count, std::optional<int> preferred = {}) {
   if (count < 1 || count > 64) throw std::logic_error("mostInliersAt: 1 to 64 offsets at a time");
   std::vector<size_t> inliers(static_cast<size_t>(count), 0);
   std::vector<uint64_t> lanes(static_cast<size_t>(count + 3) / 4, 0);
+  size_t pending = 0;  // cells counted into the lanes since they were emptied: below 2^16
   const auto flush = [&] {
     for (size_t k = 0; k < inliers.size(); ++k) inliers[k] += (lanes[k / 4] >> (16 * (k % 4))) & 0xFFFF;
     std::fill(lanes.begin(), lanes.end(), 0);
+    pending = 0;
   };
-  size_t pending = 0;  // cells counted into the lanes since they were emptied: below 2^16
   for (size_t n = 0; n < cells.size(); ++n) {
     if (landing[n] < 0) continue;
     const int base = cells[n].slice + lowest;  // the target slice of offset `lowest`
-    const int first = std::max(0, base), last = std::min(slices - 1, base + count - 1);
+    const int first = std::max(0, base), last = std::min(dilated.size() - 1, base + count - 1);
     if (first > last) continue;
     uint64_t window = dilated.window(static_cast<size_t>(landing[n]), first, last - first + 1) << (first - base);
     for (size_t q = 0; window != 0; ++q, window >>= 4) lanes[q] += kNibbleLanes[window & 15];
-    if (++pending == 0xFFFF) flush(), pending = 0;
+    if (++pending == 0xFFFF) flush();
   }
   flush();
   size_t best = preferred ? static_cast<size_t>(*preferred - lowest) : 0;
@@ -300,16 +319,11 @@ int mostInliersAt(const BitColumns& dilated, int slices, const std::vector<Cell>
 }
 
 /// The height offset within `reach` slices of `middle` at which `T` lands
-/// the most source `cells` on the target's `slices` dilated slices (by
-/// column) of raster `grid` (occupancyHeightOffset).
-int mostInliersNear(const BitColumns& dilated, int slices, const std::vector<Cell>& cells, const SliceGrid& grid,
+/// the most source `cells` on the `dilated` target slices of raster `grid`
+/// (occupancyHeightOffset).
+int mostInliersNear(const std::vector<BitRaster>& dilated, const std::vector<Cell>& cells, const SliceGrid& grid,
                     const Rigid2D& T, int middle, int reach) {
-  return mostInliersAt(dilated, slices, cells, landings(cells, T, grid), middle - reach, 2 * reach + 1, middle);
-}
-
-/// `dilated`, a stack's dilated slices on raster `grid`, by column.
-BitColumns columnsOf(const std::vector<BitRaster>& dilated, const SliceGrid& grid) {
-  return BitColumns(dilated, static_cast<size_t>(grid.width) * static_cast<size_t>(grid.height));
+  return mostInliersAt(SliceWindows{dilated}, cells, landings(cells, T, grid), middle - reach, 2 * reach + 1, middle);
 }
 
 /// Every slice's occupancy grown by inlier_radius_cells (BitRaster::disk): a
@@ -364,7 +378,6 @@ std::pair<JudgedMap, JudgedMap> judgedMaps(const SliceStack& t, const SliceStack
 struct PoseJudge {
   const SliceStack &target, &source;
   std::vector<BitRaster> dilated, source_dilated;
-  BitColumns dilated_columns;  ///< `dilated` by column: where a pose's height is chosen
   std::vector<Cell> source_cells, target_cells;
   std::vector<Cell> source_telling, target_telling;  ///< the telling ones alone: all a score counts
   Enclosure target_encloses, source_encloses;
@@ -413,7 +426,6 @@ struct PoseJudge {
         source(s),
         dilated(std::move(maps.first.dilated)),
         source_dilated(std::move(maps.second.dilated)),
-        dilated_columns(columnsOf(dilated, t.grid)),
         source_cells(std::move(maps.second.cells)),
         target_cells(std::move(maps.first.cells)),
         source_telling(std::move(maps.second.telling)),
@@ -506,8 +518,7 @@ PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const
     return out;
   };
   height_ = [judge](const Rigid2D& T, int middle, int reach) {
-    return mostInliersNear(judge->dilated_columns, judge->target.size(), judge->source_cells, judge->target.grid, T,
-                           middle, reach);
+    return mostInliersNear(judge->dilated, judge->source_cells, judge->target.grid, T, middle, reach);
   };
 }
 
@@ -537,8 +548,8 @@ DensePose landPose(const SliceStack& target, const SliceStack& source, const Rig
 
 int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
                           const DenseSearchParams& params) {
-  return mostInliersNear(columnsOf(dilatedSlices(target, params), target.grid), target.size(),
-                         cellsOf(source, params.wall_spread), target.grid, T, middle, reach);
+  return mostInliersNear(dilatedSlices(target, params), cellsOf(source, params.wall_spread), target.grid, T, middle,
+                         reach);
 }
 
 bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params) {
@@ -678,6 +689,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
 
   // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
   std::vector<DensePose> refined(coarse.size());
+  const BitColumns columns(judge.dilated, static_cast<size_t>(tg.width) * static_cast<size_t>(tg.height));
   const OccupancyRefiner refine(target, source);
   DenseRefineParams refine_params;
   refine_params.max_cells = params.refine_cells;
@@ -688,8 +700,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
     std::vector<int> landing;
     const auto bestOffsetNear = [&](int middle, int reach) {
       landing = landings(source_cells, p.transform, tg);
-      p.offset =
-          mostInliersAt(judge.dilated_columns, target.size(), source_cells, landing, middle - reach, 2 * reach + 1);
+      p.offset = mostInliersAt(columns, source_cells, landing, middle - reach, 2 * reach + 1);
     };
     bestOffsetNear(p.offset, c - 1);
     p.transform = refine(p.offset, p.transform, refine_params).transform;

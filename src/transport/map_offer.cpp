@@ -286,7 +286,7 @@ Rejection validate(const wire::MapAnnouncement& a) {
   }
   // Unseen runs in pairs, in range, ascending and apart, over no slice it sends (a slice with cells was seen).
   const auto& unseen = a.unseen();
-  if (unseen.size() % 2 != 0) return {Reject::BadUnseen};
+  if (unseen.size() % 2 != 0) return {Reject::UnpairedUnseen};
   for (size_t i = 0; i < unseen.size(); i += 2) {
     const int32_t first = unseen[i], last = unseen[i + 1];
     const bool apart = i == 0 || first > unseen[i - 1] + 1;

@@ -22,8 +22,9 @@ std::string Rejection::text() const {
       return "announcement with feature settings out of range";
     case Reject::VersionMismatch:
       return "announcement whose version does not match its content";
+    case Reject::UnpairedUnseen:
+      return "announcement with an unseen run without its last slice";
     case Reject::BadUnseen:
-      if (slice < 0) return "announcement with an unseen run without its last slice";
       return "announcement with unseen slices out of range, out of order or sent (from slice " + std::to_string(slice) +
              ")";
     case Reject::BadUp:

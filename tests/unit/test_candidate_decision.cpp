@@ -216,6 +216,18 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   EXPECT_EQ(v.answer, 0) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::corroborated);
 
+  // A pose the other map's empty space contradicts is not a right answer
+  // with its copy: 24 % as many telling cells in that space as on its
+  // occupancy (both ways, as the climb lands it) against at most 20 %.
+  Candidate contradicted = right;
+  contradicted.landed.telling_inliers = 1000, contradicted.landed.contradicted = 240;
+  v = decideOnCandidates({contradicted, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
+  EXPECT_EQ(v.answer, -1);
+  EXPECT_NE(v.reason.find("it lands 24 % as many telling cells in space the other map saw empty"), std::string::npos)
+      << v.reason;
+  contradicted.landed.contradicted = 200;
+  EXPECT_EQ(decideOnCandidates({contradicted, along}, p, 0.1, Eigen::Vector2d::Zero(), wide).answer, 0);
+
   // No slice-pair estimate there: the occupancy's word alone, which is not clear.
   Candidate unvoted = right;
   unvoted.feature_votes.clear();

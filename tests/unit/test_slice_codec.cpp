@@ -173,11 +173,12 @@ TEST(SliceCodec, TheHeightsAMapSawNothingAtTravelWithIt) {
   EXPECT_EQ(lie({gap, gap, gap + 2, gap + 2}), Reject::None) << "two runs, apart";
   EXPECT_EQ(lie({gap, gap, gap + 1, gap + 1}), Reject::BadUnseen) << "two runs that are one";
   EXPECT_EQ(lie({gap + 2, gap + 2, gap, gap}), Reject::BadUnseen) << "out of order";
-  EXPECT_EQ(lie({sent}), Reject::BadUnseen) << "not in pairs";
+  EXPECT_EQ(lie({sent}), Reject::UnpairedUnseen) << "not in pairs";
   EXPECT_EQ(lie({sent}).text(), "announcement with an unseen run without its last slice");
   EXPECT_EQ(lie({sent, sent}), Reject::BadUnseen) << "over a slice it sends";
   EXPECT_EQ(lie({count, count}), Reject::BadUnseen) << "out of range";
   EXPECT_EQ(lie({-1, -1}), Reject::BadUnseen) << "out of range";
+  EXPECT_NE(lie({-1, -1}).text().find("from slice -1"), std::string::npos) << lie({-1, -1}).text();
   EXPECT_EQ(lie({1, 0}), Reject::BadUnseen) << "a run upside down";
   EXPECT_EQ(lie({}), Reject::None) << "saying nothing: every height seen";
   wire::MapAnnouncement a = offer.announcement;  // other runs under the old version

@@ -123,6 +123,11 @@ TEST(Slices, AHeightWithNoPointIsUnseenWhereASparseOneIsSeen) {
       {0, 25, true}, {26, 29, false}, {30, 30, true}, {31, 33, false}, {34, 34, true}};
   for (size_t i = 0; i < runs.size(); ++i)
     EXPECT_EQ(std::tuple(runs[i].first, runs[i].last, runs[i].seen), expected_runs[i]) << "run " << i;
+  SliceStack unsaid = s;  // a stack that does not say: every slice seen
+  unsaid.seen.clear();
+  ASSERT_EQ(seenRuns(unsaid).size(), 1u);
+  EXPECT_EQ(std::tuple(seenRuns(unsaid)[0].first, seenRuns(unsaid)[0].last), std::tuple(0, 34));
+  EXPECT_TRUE(seenRuns(SliceStack{}).empty());
   const SliceStack p = pooled(s);
   ASSERT_EQ(p.seen.size(), p.cells.size());
   EXPECT_TRUE(p.seen[15]);   // fine slices 30 and 31
