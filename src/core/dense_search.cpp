@@ -287,9 +287,9 @@ struct SliceWindows {
 /// needs the inliers alone, not the rest of a tally.
 ///
 /// A cell's offsets are one window down its column, counted four offsets
-/// to a word (kNibbleLanes). A dense search reads its windows off
-/// BitColumns: on the slowest matrix pair that took half the time of
-/// testing each offset's slice in turn.
+/// to a word (kNibbleLanes). On maps a dense search reaches the windows are
+/// read off BitColumns: on the slowest matrix pair that took half the time
+/// of testing each offset's slice in turn.
 template <typename Columns>
 int mostInliersAt(const Columns& dilated, const std::vector<Cell>& cells, const std::vector<int>& landing, int lowest,
                   int count, std::optional<int> preferred = {}) {
@@ -321,9 +321,15 @@ int mostInliersAt(const Columns& dilated, const std::vector<Cell>& cells, const 
 /// The height offset within `reach` slices of `middle` at which `T` lands
 /// the most source `cells` on the `dilated` target slices of raster `grid`
 /// (occupancyHeightOffset).
-int mostInliersNear(const std::vector<BitRaster>& dilated, const std::vector<Cell>& cells, const SliceGrid& grid,
-                    const Rigid2D& T, int middle, int reach) {
-  return mostInliersAt(SliceWindows{dilated}, cells, landings(cells, T, grid), middle - reach, 2 * reach + 1, middle);
+template <typename Columns>
+int mostInliersNear(const Columns& dilated, const std::vector<Cell>& cells, const SliceGrid& grid, const Rigid2D& T,
+                    int middle, int reach) {
+  return mostInliersAt(dilated, cells, landings(cells, T, grid), middle - reach, 2 * reach + 1, middle);
+}
+
+/// `dilated`, the dilated slices of a stack on raster `grid`, by column.
+BitColumns columnsOf(const std::vector<BitRaster>& dilated, const SliceGrid& grid) {
+  return BitColumns(dilated, static_cast<size_t>(grid.width) * static_cast<size_t>(grid.height));
 }
 
 /// Every slice's occupancy grown by inlier_radius_cells (BitRaster::disk): a
@@ -517,8 +523,20 @@ PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const
       judge->forth(landings(judge->source_cells, poses[n].first, judge->target.grid), poses[n].second, &out[n]);
     return out;
   };
-  height_ = [judge](const Rigid2D& T, int middle, int reach) {
-    return mostInliersNear(judge->dilated, judge->source_cells, judge->target.grid, T, middle, reach);
+  // On maps a dense search reaches (the wide one's bound: BitColumns take a
+  // word a pixel per 64 slices, at most a few MB there) a candidate's height
+  // is read down the target's columns; on larger ones, slice by slice.
+  DenseSearchParams widest = params;
+  widest.coarse_side = std::max(params.coarse_side, kWideCoarseSide);
+  if (!denseSearchable(target, widest)) {
+    height_ = [judge](const Rigid2D& T, int middle, int reach) {
+      return mostInliersNear(SliceWindows{judge->dilated}, judge->source_cells, judge->target.grid, T, middle, reach);
+    };
+    return;
+  }
+  const auto columns = std::make_shared<const BitColumns>(columnsOf(judge->dilated, target.grid));
+  height_ = [judge, columns](const Rigid2D& T, int middle, int reach) {
+    return mostInliersNear(*columns, judge->source_cells, judge->target.grid, T, middle, reach);
   };
 }
 
@@ -548,8 +566,8 @@ DensePose landPose(const SliceStack& target, const SliceStack& source, const Rig
 
 int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
                           const DenseSearchParams& params) {
-  return mostInliersNear(dilatedSlices(target, params), cellsOf(source, params.wall_spread), target.grid, T, middle,
-                         reach);
+  return mostInliersNear(SliceWindows{dilatedSlices(target, params)}, cellsOf(source, params.wall_spread), target.grid,
+                         T, middle, reach);
 }
 
 bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params) {
@@ -689,7 +707,7 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
 
   // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
   std::vector<DensePose> refined(coarse.size());
-  const BitColumns columns(judge.dilated, static_cast<size_t>(tg.width) * static_cast<size_t>(tg.height));
+  const BitColumns columns = columnsOf(judge.dilated, tg);
   const OccupancyRefiner refine(target, source);
   DenseRefineParams refine_params;
   refine_params.max_cells = params.refine_cells;
