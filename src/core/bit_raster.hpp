@@ -103,9 +103,9 @@ class BitColumns {
     for (size_t k = 0; k < rasters.size(); ++k)
       rasters[k].forEachSet([&](size_t idx) { bits_[idx * words_ + k / 64] |= uint64_t{1} << (k % 64); });
   }
+  int size() const { return rasters_; }  ///< the rasters'
   /// Rasters first to first + count - 1 at pixel `idx`, raster `first` in
   /// bit 0: 0 <= first, first + count <= the rasters' number, 1 <= count <= 64.
-  int size() const { return rasters_; }  ///< the rasters'
   uint64_t window(size_t idx, int first, int count) const {
     const uint64_t* column = &bits_[idx * words_];
     const auto word = static_cast<size_t>(first) / 64, bit = static_cast<size_t>(first) % 64;
