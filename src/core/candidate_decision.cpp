@@ -53,8 +53,10 @@ template <typename SamePlace>
 size_t finestAt(const std::vector<Candidate>& candidates, size_t at, const SamePlace& samePlace) {
   const auto own = [&](size_t i) { return total(bySlice(candidates[i].slices)); };
   size_t best = at;
+  double most = own(at);
   for (size_t i = 0; i < candidates.size(); ++i)
-    if (samePlace(candidates[i], candidates[at]) && own(i) > own(best)) best = i;
+    if (samePlace(candidates[i], candidates[at]))
+      if (const double o = own(i); o > most) best = i, most = o;
   return best;
 }
 
