@@ -44,8 +44,9 @@ struct Row {
          peak_rss_mb = 0;
   double features = 0, slices = 0, payload_bytes = 0, raw_bytes = 0;
   std::string note;
-  /// With --candidates: what the decision over them (on trial) gives, "right",
-  /// "wrong" or "refused"; empty where it did not run.
+  /// With --decision verdict --candidates: what the decision over the
+  /// candidates, beside the verdict, gives: "right", "wrong" or "refused";
+  /// empty where it did not run or answered itself.
   std::string candidate_decision;
 };
 
@@ -201,7 +202,7 @@ std::string summary(const std::string& suite, const std::vector<Row>& rows, cons
   for (const auto& [key, f] : families)
     o << "| " << key.first << " | " << key.second << " | " << f[0] + f[1] + f[2] + f[3] << " | " << f[0] << " | "
       << f[1] << " | " << f[2] << " | " << f[3] << " |\n";
-  // With --candidates: the decision over them, on trial, beside the answers.
+  // With --decision verdict --candidates: the decision over the candidates beside the verdict's answers.
   std::map<std::string, std::array<int, 4>> trial;  // the verdict's right; the trial's right, refused, wrong
   for (const auto& r : rows)
     if (!r.candidate_decision.empty()) {
@@ -210,10 +211,9 @@ std::string summary(const std::string& suite, const std::vector<Row>& rows, cons
       ++t[r.candidate_decision == "right" ? 1 : r.candidate_decision == "refused" ? 2 : 3];
     }
   if (!trial.empty()) {
-    o << "\nOne decision over the candidates, on trial (docs/algorithm.md; its answer is judged as the verdict's, "
-         "after the 6-DoF finish where that holds):\n\n| family | the answers right | on trial: right | refused | "
-         "wrong "
-         "|\n|---|---|---|---|---|\n";
+    o << "\nOne decision over the candidates, beside the verdict (docs/algorithm.md; its answer is judged as the "
+         "verdict's, after the 6-DoF finish where that holds):\n\n| family | the verdict's right | the decision: "
+         "right | refused | wrong |\n|---|---|---|---|---|\n";
     std::array<int, 4> sum{};
     for (const auto& [family, t] : trial) {
       o << "| " << family << " | " << t[0] << " | " << t[1] << " | " << t[2] << " | " << t[3] << " |\n";

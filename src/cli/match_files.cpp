@@ -146,12 +146,12 @@ void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
         ->delimiter(',');
   sub.add_flag("--candidates", o.params.candidates,
                "list every pose the searches proposed, refined and scored on the occupancy, with its error "
-               "where ground truth is given (diagnostics: every search runs)");
+               "where ground truth is given");
   std::map<std::string, Decision> decisions;
   for (const Decision d : kDecisions) decisions[decisionName(d)] = d;
   sub.add_option("--decision", o.params.decision,
-                 "what answers: the verdict, or the one decision over the candidates (on trial until it may "
-                 "replace the verdict)")
+                 "what answers: the one decision over the candidates, or the verdict it replaced (kept for "
+                 "comparison)")
       ->transform(CLI::CheckedTransformer(decisions))
       ->default_str(decisionName(MatchParams{}.decision));
   sub.add_flag("--exhaustive", o.params.exhaustive,

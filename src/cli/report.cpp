@@ -265,9 +265,8 @@ nlohmann::json candidatesJson(const MatchResult& r, const std::vector<std::optio
 
 /// The candidates, best refined score first: where each came from, its score
 /// as proposed and refined, and its error where the truth is known.
-void printCandidates(std::ostream& out, const MatchResult& r,
-                     const std::vector<std::optional<GroundTruthCheck>>& checks,
-                     const std::optional<GroundTruthCheck>& finished_check) {
+void listCandidates(std::ostream& out, const MatchResult& r,
+                    const std::vector<std::optional<GroundTruthCheck>>& checks) {
   std::vector<size_t> order(r.candidates.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
@@ -282,9 +281,13 @@ void printCandidates(std::ostream& out, const MatchResult& r,
     if (checks[i]) out << "  " << candidateErrorText(*checks[i]);
     out << "\n";
   }
-  if (!r.candidate_verdict) return;
+}
+
+/// What the decision over the candidates said: its answer, and what it
+/// answered on, or why it has none.
+void printDecision(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& finished_check) {
   const CandidateVerdict& v = *r.candidate_verdict;
-  const char* role = r.decision == Decision::candidates ? "(the answer)" : "(on trial, not the answer)";
+  const char* role = r.decision == Decision::candidates ? "(the answer)" : "(beside the verdict, not the answer)";
   if (v.answer < 0)
     out << "one decision     " << role << " no reliable match: " << v.reason << "\n";
   else
@@ -301,7 +304,7 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
   std::optional<GroundTruthCheck> gt;
   if (truth) gt = checkAgainstGroundTruth(r, *truth, grid);
   const std::vector<std::optional<GroundTruthCheck>> checks = candidateChecks(r, truth, grid);
-  std::optional<GroundTruthCheck> finished_check;  // the decision on trial's answer, finished
+  std::optional<GroundTruthCheck> finished_check;  // the decision's answer, finished
   if (truth && r.candidate_verdict && r.candidate_verdict->finished)
     finished_check = checkAgainstGroundTruth(*r.candidate_verdict->finished, *truth, grid);
   const bool json_to_stdout = how.json == "-";
@@ -310,7 +313,8 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
     text << resultLine(r) << "\n";
   else
     printResult(text, r, gt, how.method);
-  if (!how.quiet && !r.candidates.empty()) printCandidates(text, r, checks, finished_check);
+  if (!how.quiet && how.candidates && !r.candidates.empty()) listCandidates(text, r, checks);
+  if (!how.quiet && r.candidate_verdict) printDecision(text, r, finished_check);
   if (!how.json.empty()) {
     auto j = toJson(r, gt);
     j["schema_version"] = kJsonSchemaVersion;
@@ -319,7 +323,7 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
     if (how.method == "tomomap") j["decision"] = decisionName(r.decision);
     j["grid"] = grid;
     if (extra.is_object()) j.update(extra);
-    if (!r.candidates.empty()) j["candidates"] = candidatesJson(r, checks);
+    if (how.candidates && !r.candidates.empty()) j["candidates"] = candidatesJson(r, checks);
     if (r.candidate_verdict) {
       const CandidateVerdict& v = *r.candidate_verdict;
       j["candidate_decision"] = {{"answer", v.answer >= 0 ? nlohmann::json(v.answer) : nlohmann::json()},

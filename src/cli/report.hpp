@@ -51,6 +51,7 @@ struct ReportOptions {
   std::string json;
   std::string method = "tomomap";  ///< tomomap, or a baseline's name (tomomap-baseline --method)
   bool quiet = false;
+  bool candidates = false;  ///< list every candidate, as text and in the JSON (--candidates)
 };
 
 /// Prints the result (and its error against ground truth when both poses are

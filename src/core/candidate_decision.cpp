@@ -170,7 +170,8 @@ bool byCorroboration(CandidateVerdict& v, const std::vector<Candidate>& candidat
 /// answers, where it leads the most agreed-with elsewhere beyond chance and
 /// the occupancy does not tell against it (no candidate elsewhere lands
 /// more, `landed`, beyond chance). Whether it answered; `v` says why not.
-/// `bestElsewhere(at, better)`: the best by `better` not at `at`'s place.
+/// `bestElsewhere(at, better)`: the best by `better` not at `at`'s place, -1
+/// where there is none.
 template <typename SamePlace, typename BestElsewhere>
 bool byVotes(CandidateVerdict& v, const std::vector<Candidate>& candidates, const std::vector<SliceScores>& scores,
              const std::vector<double>& landed, const std::vector<int>& agreeing, const SamePlace& samePlace,
@@ -179,10 +180,14 @@ bool byVotes(CandidateVerdict& v, const std::vector<Candidate>& candidates, cons
   size_t voted = 0;
   for (size_t i = 1; i < candidates.size(); ++i)
     if (agreed_more(i, voted)) voted = i;
-  if (agreeing[voted] == 0) return false;
+  if (agreeing[voted] == 0) {
+    v.reason += "; no slice-pair estimate of the features agrees with any candidate";
+    return false;
+  }
+  // With no candidate elsewhere, nothing elsewhere has a vote.
   const int other = bestElsewhere(voted, agreed_more);
-  if (other < 0) return false;
-  const std::pair<double, int> by_votes = votesLead(candidates[voted], candidates[static_cast<size_t>(other)]);
+  const std::pair<double, int> by_votes =
+      votesLead(candidates[voted], other < 0 ? Candidate{} : candidates[static_cast<size_t>(other)]);
   v.reason += "; the candidate most slice pairs agree with leads the most agreed-with elsewhere by " +
               fixed(by_votes.first, 1) + " sigma over " + std::to_string(by_votes.second) + " source slices";
   if (by_votes.first < kBars.significant) return false;
@@ -290,6 +295,15 @@ CandidateVerdict decidePlace(const std::vector<Candidate>& candidates, const Mat
   for (size_t i = 1; i < candidates.size(); ++i)
     if (lands_more(i, best)) best = i;
   const int rival = bestElsewhere(best, lands_more);
+  // A map whose occupancy came in part (refineAndLand) lands no candidate:
+  // the features' votes alone can answer.
+  const bool landed_any =
+      std::any_of(candidates.begin(), candidates.end(), [](const Candidate& c) { return !c.slices.empty(); });
+  if (!landed_any) {
+    v.reason = "no candidate landed on the occupancy (a map's slices came as features)";
+    byVotes(v, candidates, scores, landed, agreeing, samePlace, bestElsewhere);
+    return v;
+  }
   std::pair<double, int> lead{0.0, 0};
   if (rival >= 0) lead = occupancyLead(scores[best], scores[static_cast<size_t>(rival)]);
   if (lead.first >= kBars.significant) {

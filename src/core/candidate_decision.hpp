@@ -1,8 +1,8 @@
 #pragma once
-// One decision over the candidates, on trial beside the verdict (verdict.hpp)
-// until it may replace it: the best candidate answers when its lead over the
-// best candidate elsewhere, slice by slice, is beyond chance
-// (docs/algorithm.md, "One decision, on trial").
+// One decision over the candidates, which answers a match (the verdict it
+// replaced, verdict.hpp, is kept beside it for comparison): the best
+// candidate answers when its lead over the best candidate elsewhere, slice
+// by slice, is beyond chance (docs/algorithm.md, "One decision").
 #include <optional>
 #include <string>
 #include <vector>

@@ -77,7 +77,7 @@ std::optional<Candidate::From> fromName(const std::string& name) {
 std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeatures& source,
                                      const std::vector<Proposal>& proposals, const MatchParams& params,
                                      const FeatureVotes& votes) {
-  if (target.occupancy.partial || source.occupancy.partial || proposals.empty()) return {};
+  if (proposals.empty()) return {};
   DenseSearchParams dp;
   dp.threads = matchThreads(params);
   const PoseLander land(target.occupancy, source.occupancy, dp);

@@ -63,8 +63,7 @@ struct Proposal {
 /// refined: uphill (nearby_poses.hpp) on maps small enough for a dense
 /// search, by one ICP on the occupancy (dense_refine.hpp) on larger ones.
 /// Then every one takes the occupancy's height within half the smear of its
-/// own (PoseLander::heightOffset). Empty where either map's occupancy is
-/// partial.
+/// own (PoseLander::heightOffset).
 std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeatures& source,
                                      const std::vector<Proposal>& proposals, const MatchParams& params,
                                      const FeatureVotes& votes = {});

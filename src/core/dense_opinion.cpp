@@ -222,11 +222,11 @@ void answerByCandidates(MatchResult& r, const Evidence& e, const MapFeatures& ta
   const CandidateVerdict& v = *r.candidate_verdict;
   r.reliable = v.answer >= 0;
   r.reason = v.reason;
-  if (r.candidates.empty()) {
-    if (!e.features.missing.empty()) r.reason += ": " + e.features.missing;
-    if (!denseSearchable(target.occupancy, wideSearch()) || !denseSearchable(source.occupancy, wideSearch()))
-      r.reason += "; the maps are too large for a dense search of their occupancy";
-  }
+  if (!r.reliable && !e.features.missing.empty())
+    r.reason += (r.candidates.empty() ? ": " : "; the features: ") + e.features.missing;
+  if (r.candidates.empty() &&
+      (!denseSearchable(target.occupancy, wideSearch()) || !denseSearchable(source.occupancy, wideSearch())))
+    r.reason += "; the maps are too large for a dense search of their occupancy";
   if (!r.reliable) return;
   const Candidate& c = r.candidates[static_cast<size_t>(v.answer)];
   r.T_target_source = poseAt(c.landed.transform, c.landed.offset, target, source);

@@ -489,13 +489,6 @@ std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, cons
 }
 
 PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params) {
-  if (target.partial || source.partial) {
-    land_ = [](const Poses&) { return std::vector<DensePose>{}; };
-    score_ = [](const Poses&) { return std::vector<double>{}; };
-    slices_ = [](const Poses&) { return std::vector<std::vector<SliceLanding>>{}; };
-    height_ = [](const Rigid2D&, int middle, int) { return middle; };
-    return;
-  }
   const auto judge = std::make_shared<const PoseJudge>(target, source, params);
   const int threads = std::max(1, params.threads);
   land_ = [judge, threads](const Poses& poses) {

@@ -102,13 +102,12 @@ int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, co
 
 /// The pose (T, offset) judged as the search judges its poses (inliers, telling
 /// cells both ways, what it contradicts), without searching or refining: for a
-/// pose found otherwise, such as the features' answer. Nothing landed (all
-/// counts 0) where either stack is partial.
+/// pose found otherwise, such as the features' answer. Of a partial stack
+/// (SliceStack::partial) the slices it holds land; those it does not are unseen.
 DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                    const DenseSearchParams& params = {});
 
-/// landPose for several poses (T, offset), the maps' occupancy prepared once;
-/// empty where either stack is partial.
+/// landPose for several poses (T, offset), the maps' occupancy prepared once.
 std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& source,
                                  const std::vector<std::pair<Rigid2D, int>>& poses,
                                  const DenseSearchParams& params = {});
@@ -125,8 +124,8 @@ struct SliceLanding {
 };
 
 /// Each pose (T, offset) landed slice by slice, the source's cells on the
-/// target alone (the candidates' landings, candidates.hpp); empty where
-/// either stack is partial. PoseLander::slices with the stacks prepared once.
+/// target alone (the candidates' landings, candidates.hpp). PoseLander::slices
+/// with the stacks prepared once.
 std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, const SliceStack& source,
                                                   const std::vector<std::pair<Rigid2D, int>>& poses,
                                                   const DenseSearchParams& params = {});
@@ -138,15 +137,15 @@ class PoseLander {
  public:
   using Poses = std::vector<std::pair<Rigid2D, int>>;  ///< (T, offset) each
   PoseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params = {});
-  /// Each pose landed (landPose); empty where either stack is partial.
+  /// Each pose landed (landPose).
   std::vector<DensePose> operator()(const Poses& poses) const;
   /// Each pose's DensePose::score() alone, counted on the telling cells alone
   /// (the only ones it weighs): for a caller that ranks many poses and lands
-  /// only the best (a climb, nearby_poses.hpp). Empty where either stack is partial.
+  /// only the best (a climb, nearby_poses.hpp).
   std::vector<double> scores(const Poses& poses) const;
-  /// Each pose landed slice by slice (landSlices); empty where either stack is partial.
+  /// Each pose landed slice by slice (landSlices).
   std::vector<std::vector<SliceLanding>> slices(const Poses& poses) const;
-  /// occupancyHeightOffset on the occupancy prepared; `middle` where either stack is partial.
+  /// occupancyHeightOffset on the occupancy prepared.
   int heightOffset(const Rigid2D& T, int middle, int reach) const;
 
  private:

@@ -7,8 +7,9 @@
 
 namespace tomomap {
 
-/// What answers a match: the verdict (verdict.hpp), or the one decision over
-/// the candidates (candidate_decision.hpp), on trial until it may replace it.
+/// What answers a match: the one decision over the candidates
+/// (candidate_decision.hpp), or the verdict it replaced (verdict.hpp), kept
+/// for comparison until it is deleted.
 enum class Decision { verdict, candidates };
 
 /// A decision's name ("verdict", "candidates"), as the CLI and the JSON give it.
@@ -52,9 +53,8 @@ struct MatchParams {
   bool candidates = false;
   /// What answers (Decision): with Decision::candidates the candidates are
   /// gathered as `candidates` asks, the decision over them answers, and the
-  /// verdict does not run. That decision needs both maps' occupancy: a
-  /// daemon's peer slices may come without it, so the daemon keeps the verdict.
-  Decision decision = Decision::verdict;
+  /// verdict does not run.
+  Decision decision = Decision::candidates;
 };
 
 /// Whether a match gathers the candidates: asked for, or they decide.

@@ -249,8 +249,8 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
   }
   const bool candidate_answer = r.candidate_verdict && r.candidate_verdict->answer >= 0;
   if (candidate_answer && params.decision == Decision::verdict && params.finish) {
-    // The decision on trial's answer, finished as the verdict's is (its time
-    // counted with the finish's).
+    // The decision's answer beside the verdict, finished as the verdict's is
+    // (its time counted with the finish's).
     const auto t0 = Clock::now();
     const Candidate& c = r.candidates[static_cast<size_t>(r.candidate_verdict->answer)];
     const SixDofFinish f = finishSixDof(target.occupancy, source.occupancy,

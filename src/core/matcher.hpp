@@ -103,13 +103,13 @@ struct MatchResult {
   size_t target_features = 0, source_features = 0;
   StageTimings timings;
   /// What answered (MatchParams::decision).
-  Decision decision = Decision::verdict;
+  Decision decision = Decision::candidates;
   /// Where the match gathers candidates (gathersCandidates): every candidate
   /// pose the searches proposed, refined and landed (candidates.hpp).
   std::vector<Candidate> candidates;
   /// Where the match gathers candidates: the decision over them
-  /// (candidate_decision.hpp); the answer with Decision::candidates, on trial
-  /// beside the verdict otherwise (it then changes no answer).
+  /// (candidate_decision.hpp); the answer with Decision::candidates, beside
+  /// the verdict otherwise (it then changes no answer).
   std::optional<CandidateVerdict> candidate_verdict;
 };
 

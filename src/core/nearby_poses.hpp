@@ -12,8 +12,7 @@ namespace tomomap {
 /// height_offsets.hpp), each judged as the dense search judges its poses (PoseLander). A pose whose
 /// neighbourhood holds one that lands as much lies on a ridge of the
 /// occupancy (a street's facades, two parallel walls) that the coarse raster
-/// of a dense search cannot resolve. Nothing landed (all counts 0) where
-/// either stack is partial.
+/// of a dense search cannot resolve.
 DensePose bestAround(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset, int inner_cells,
                      int outer_cells, const DenseSearchParams& params = {});
 
@@ -26,7 +25,7 @@ DensePose bestAround(const SliceStack& target, const SliceStack& source, const R
 /// within a few cells, and a feature answer on a few slice pairs is a few
 /// pixels' keypoints: on real crops both stopped short of the right pose,
 /// 0.35-1.7 m and 3-7 deg off it, where the right pose landed 13-48 % more.
-/// (T, offset) itself, landed, where nothing uphill lands more or either stack is partial.
+/// (T, offset) itself, landed, where nothing uphill lands more.
 DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                  const DenseSearchParams& params = {});
 /// uphill with `land` and `refine`, a lander and a refiner of the same two

@@ -83,6 +83,9 @@ struct RoomMatch {
   bool answeredWrong(double grid) const { return result.reliable && !right(grid); }
 };
 
+/// The tests of SmallRooms and SmallMaps below keep the cases that shaped
+/// the verdict's rules, and match with it (`decision`) while it is kept
+/// beside the decision that replaced it; the matrix gates the decision.
 RoomMatch matchWorld(WorldType type, uint64_t seed, const char* noise, double grid,
                      Decision decision = Decision::verdict) {
   SceneParams sp;

@@ -67,7 +67,9 @@ TEST(Cli, MatchDemoRoomPrintsTransformErrorAndJson) {
   EXPECT_EQ(j["T_target_source"]["matrix"].size(), 4u);
   EXPECT_TRUE(j["error"]["success"].get<bool>());
   EXPECT_GT(j["features"]["support"].get<int>(), 3);
-  EXPECT_GT(j["lead_sigma"].get<double>(), 3.0) << "a clear answer, as the pose graph weighs it";
+  // The pair's weight in the pose graph: the decision's lead, in standard deviations.
+  EXPECT_GT(j["lead_sigma"].get<double>(), 0.0);
+  EXPECT_EQ(j["lead_sigma"], j["candidate_decision"]["lead_sigma"]);
 }
 
 TEST(Cli, MissingFile) { expectBadInput(runTomomap("match /nonexistent/a.pcd /nonexistent/b.pcd"), "no such file"); }
@@ -315,24 +317,25 @@ TEST(Cli, CandidatesListEveryProposedPoseScoredWithItsError) {
   for (const char* search : {"features", "search_at_grid", "search_wide", "search_pooled"})
     EXPECT_TRUE(from.count(search)) << search << " proposed nothing\n" << r.output;
   EXPECT_TRUE(best_right) << "on this room the best-scoring candidate is the right pose\n" << r.output;
-  // The decision on trial answers a right candidate here, clear beyond chance, and says so.
+  // The decision answers a right candidate here, clear beyond chance, and says so.
   const auto& trial = j["candidate_decision"];
   ASSERT_FALSE(trial["answer"].is_null()) << trial.dump();
   EXPECT_TRUE(j["candidates"].at(trial["answer"].get<size_t>())["error"]["success"].get<bool>()) << trial.dump();
   EXPECT_GE(trial["lead_sigma"].get<double>(), 3.0);
-  EXPECT_NE(r.output.find("one decision     (on trial, not the answer)"), std::string::npos) << r.output;
-  // Its answer is finished in 6-DoF as the verdict's is, and judged so: a
-  // level room's right answer stays right and within a cell of the truth.
+  EXPECT_NE(r.output.find("one decision     (the answer)"), std::string::npos) << r.output;
+  // Its answer is finished in 6-DoF, and judged so: a level room's right
+  // answer stays right and within a cell of the truth.
   ASSERT_TRUE(trial.value("finished", false)) << trial.dump();
   EXPECT_TRUE(trial["finished_error"]["success"].get<bool>()) << trial.dump();
   EXPECT_LT(trial["finished_error"]["translation"].get<double>(), 0.1) << trial.dump();
   EXPECT_NE(r.output.find("finished in 6-DoF: error"), std::string::npos) << r.output;
   const auto plain = runTomomap("match " + w + "/map_0.pcd " + w + "/map_1.pcd --grid 0.1 --json " + (dir / "p.json"));
+  EXPECT_EQ(plain.output.find("candidates       "), std::string::npos) << "listed only when asked\n" << plain.output;
   EXPECT_FALSE(nlohmann::json::parse(std::ifstream(dir / "p.json")).contains("candidates")) << "only when asked";
 }
 
-// --decision candidates: the one decision over the candidates answers, and
-// the pose it returns is the candidate it judged (the verdict does not run).
+// The one decision over the candidates answers (the default), and the pose
+// it returns is the candidate it judged (the verdict does not run).
 TEST(Cli, TheDecisionOverTheCandidatesAnswersWithThePoseItJudged) {
   TempDir dir;
   const std::string w = dir / "room";
@@ -341,7 +344,7 @@ TEST(Cli, TheDecisionOverTheCandidatesAnswersWithThePoseItJudged) {
                            "/map_0-gtpose.txt --gt-source " + w + "/map_1-gtpose.txt";
   for (const bool finish : {false, true}) {
     const std::string json = dir / (finish ? "finished.json" : "judged.json");
-    const auto r = runTomomap(pair + " --decision candidates" + (finish ? "" : " --no-finish") + " --json " + json);
+    const auto r = runTomomap(pair + " --candidates" + (finish ? "" : " --no-finish") + " --json " + json);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find("one decision     (the answer) "), std::string::npos) << r.output;
     const auto j = nlohmann::json::parse(std::ifstream(json));
@@ -370,11 +373,11 @@ TEST(Cli, TheDecisionOverTheCandidatesAnswersWithThePoseItJudged) {
                   1e-9);
     }
   }
-  const auto verdict = runTomomap(pair + " --json " + (dir / "v.json"));
+  const auto verdict = runTomomap(pair + " --decision verdict --json " + (dir / "v.json"));
   ASSERT_EQ(verdict.exit_code, 0) << verdict.output;
   const auto v = nlohmann::json::parse(std::ifstream(dir / "v.json"));
-  EXPECT_EQ(v["decision"], "verdict") << "the verdict answers by default";
-  EXPECT_FALSE(v.contains("candidate_decision")) << "and gathers no candidates";
+  EXPECT_EQ(v["decision"], "verdict") << "the verdict it replaced, when asked for";
+  EXPECT_FALSE(v.contains("candidate_decision")) << "gathers no candidates";
   expectBadInput(runTomomap(pair + " --decision oracle"), "--decision");
 }
 
@@ -471,8 +474,8 @@ TEST(Cli, ATiltedSynthMapIsLevelledAndRefusedWithNoLevel) {
       << refused.output;
   EXPECT_NE(refused.output.find("levelling is off"), std::string::npos) << refused.output;
   EXPECT_FALSE(nlohmann::json::parse(std::ifstream(dir / "refused.json"))["reliable"].get<bool>());
-  // The decision over the candidates refuses it as the verdict does: a tilted map's slices cut walls at a slant.
-  const auto also = runTomomap("match --no-level --decision candidates " + maps);
+  // The verdict it replaced refuses it as the decision does: a tilted map's slices cut walls at a slant.
+  const auto also = runTomomap("match --no-level --decision verdict " + maps);
   EXPECT_EQ(also.exit_code, 1) << also.output;
   EXPECT_TRUE(std::regex_search(
       also.output, std::regex(R"(no reliable match: source map is tilted 10\.0 \+- 0\.\d deg from gravity)")))
@@ -568,6 +571,6 @@ TEST(Cli, TheJsonOutputIsTheDocumentedContract) {
   for (const auto& k : written) EXPECT_TRUE(documented.count(k)) << k << " is written but not in docs/json.md";
   documented.erase("T_target_source_6dof");  // only with --level
   documented.erase("candidates");            // only with --candidates
-  documented.erase("candidate_decision");    // only with --candidates
+  documented.erase("candidate_decision");    // only where the decision ran (not with --decision verdict)
   for (const auto& k : documented) EXPECT_TRUE(written.count(k)) << k << " is in docs/json.md but not written";
 }

@@ -325,14 +325,25 @@ TEST(DenseSearch, ScoresAloneAreTheLandedPosesScores) {
     EXPECT_EQ(land.heightOffset(poses[n].first, poses[n].second, 5),
               occupancyHeightOffset(room, room, poses[n].first, poses[n].second, 5));
   }
-  SliceStack partial = room;
-  partial.partial = true;  // some slices came over the network as features
-  EXPECT_TRUE(PoseLander(room, partial).scores(poses).empty());
-  EXPECT_TRUE(PoseLander(room, partial).slices(poses).empty());
-  EXPECT_EQ(PoseLander(room, partial).heightOffset(Rigid2D{}, 3, 5), 3);
-  const DensePose around = bestAround(room, partial, Rigid2D{}, 0, 5, 20);
-  EXPECT_EQ(around.offset, 0);
-  EXPECT_EQ(around.telling_inliers, 0u);
+  // Some slices came over the network as features: unseen, without cells.
+  // The rest land as they would alone; the missing ones land nothing.
+  SliceStack partial = room, rest = room;
+  partial.partial = true;
+  partial.seen.assign(partial.cells.size(), true);
+  for (size_t k = 0; k < partial.cells.size(); k += 3) partial.cells[k].clear(), partial.seen[k] = false;
+  rest.cells = partial.cells, rest.seen = partial.seen;
+  const auto in_part = PoseLander(room, partial).slices(poses), as_rest = landSlices(room, rest, poses);
+  ASSERT_EQ(in_part.size(), poses.size());
+  for (size_t n = 0; n < poses.size(); ++n) {
+    ASSERT_EQ(in_part[n].size(), as_rest[n].size());
+    for (const SliceLanding& l : in_part[n]) {
+      if (l.slice % 3 == 0) {
+        EXPECT_EQ(l.cells, 0u) << "slice " << l.slice << " has no cells here";
+      }
+    }
+  }
+  EXPECT_EQ(PoseLander(room, partial).scores(poses), PoseLander(room, rest).scores(poses));
+  EXPECT_FALSE(denseSearchable(partial)) << "a partial stack is not searched";
 }
 
 // The height the occupancy gives a pose: where most of the source's cells
