@@ -85,16 +85,16 @@ std::pair<double, int> occupancyLead(const SliceScores& a, const SliceScores& b)
   return {sliceLeadSigma(d), static_cast<int>(d.size())};
 }
 
-/// `a`'s lead over `b` in slice-pair estimates agreeing, over the source
-/// slices where either has one, by signFlipLeadSigma: the counts are small
+/// Votes `a`'s lead over votes `b` (Candidate::feature_votes, by source
+/// slice), over the source slices where either has one, by signFlipLeadSigma: the counts are small
 /// and often the same from slice to slice, where a t reads any lead over
 /// two slices as certain.
-std::pair<double, int> votesLead(const Candidate& a, const Candidate& b) {
+std::pair<double, int> votesLead(const std::vector<int>& a, const std::vector<int>& b) {
   std::vector<double> d;
-  const size_t n = std::max(a.feature_votes.size(), b.feature_votes.size());
+  const size_t n = std::max(a.size(), b.size());
   for (size_t k = 0; k < n; ++k) {
-    const int va = k < a.feature_votes.size() ? a.feature_votes[k] : 0;
-    const int vb = k < b.feature_votes.size() ? b.feature_votes[k] : 0;
+    const int va = k < a.size() ? a[k] : 0;
+    const int vb = k < b.size() ? b[k] : 0;
     if (va > 0 || vb > 0) d.push_back(va - vb);
   }
   return {signFlipLeadSigma(d), static_cast<int>(d.size())};
@@ -187,9 +187,11 @@ bool byVotes(CandidateVerdict& v, const std::vector<Candidate>& candidates, cons
   // With no candidate elsewhere, nothing elsewhere has a vote.
   const int other = bestElsewhere(voted, agreed_more);
   const std::pair<double, int> by_votes =
-      votesLead(candidates[voted], other < 0 ? Candidate{} : candidates[static_cast<size_t>(other)]);
-  v.reason += "; the candidate most slice pairs agree with leads the most agreed-with elsewhere by " +
-              fixed(by_votes.first, 1) + " sigma over " + std::to_string(by_votes.second) + " source slices";
+      votesLead(candidates[voted].feature_votes,
+                other < 0 ? std::vector<int>{} : candidates[static_cast<size_t>(other)].feature_votes);
+  v.reason += "; the candidate most slice pairs agree with leads " +
+              std::string(other < 0 ? "no votes elsewhere (no candidate is)" : "the most agreed-with elsewhere") +
+              " by " + fixed(by_votes.first, 1) + " sigma over " + std::to_string(by_votes.second) + " source slices";
   if (by_votes.first < kBars.significant) return false;
   for (size_t i = 0; i < candidates.size(); ++i)
     if (!samePlace(candidates[i], candidates[voted]) && landed[i] > landed[voted] &&
@@ -295,15 +297,6 @@ CandidateVerdict decidePlace(const std::vector<Candidate>& candidates, const Mat
   for (size_t i = 1; i < candidates.size(); ++i)
     if (lands_more(i, best)) best = i;
   const int rival = bestElsewhere(best, lands_more);
-  // A map whose occupancy came in part (refineAndLand) lands no candidate:
-  // the features' votes alone can answer.
-  const bool landed_any =
-      std::any_of(candidates.begin(), candidates.end(), [](const Candidate& c) { return !c.slices.empty(); });
-  if (!landed_any) {
-    v.reason = "no candidate landed on the occupancy (a map's slices came as features)";
-    byVotes(v, candidates, scores, landed, agreeing, samePlace, bestElsewhere);
-    return v;
-  }
   std::pair<double, int> lead{0.0, 0};
   if (rival >= 0) lead = occupancyLead(scores[best], scores[static_cast<size_t>(rival)]);
   if (lead.first >= kBars.significant) {

@@ -84,7 +84,6 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
   std::vector<std::pair<Rigid2D, int>> poses;
   for (const Proposal& p : proposals) poses.emplace_back(p.T, p.offset);
   const std::vector<DensePose> as_proposed = land(poses);
-  if (as_proposed.size() != proposals.size()) return {};
   std::vector<Candidate> out;
   for (size_t i = 0; i < proposals.size(); ++i) {
     const Proposal& p = proposals[i];

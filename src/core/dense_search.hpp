@@ -103,7 +103,9 @@ int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, co
 /// The pose (T, offset) judged as the search judges its poses (inliers, telling
 /// cells both ways, what it contradicts), without searching or refining: for a
 /// pose found otherwise, such as the features' answer. Of a partial stack
-/// (SliceStack::partial) the slices it holds land; those it does not are unseen.
+/// (SliceStack::partial) the slices whose cells it holds land; the others
+/// land nothing and enclose no empty space, so that what the pose
+/// contradicts there is a part of what it would contradict on the whole map.
 DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                    const DenseSearchParams& params = {});
 

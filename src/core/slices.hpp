@@ -51,8 +51,7 @@ struct SliceStack {
   /// Enclosure). Empty where not known: every slice seen (seenAt).
   std::vector<bool> seen{};
   size_t stray = 0;  ///< points left out as stray returns (map_bounds.hpp)
-  /// Some slices' cells are not here: they crossed the network as features
-  /// (and are unseen here: what their heights hold is not known).
+  /// Some slices' cells are not here: they crossed the network as features.
   bool partial = false;
 
   int size() const { return static_cast<int>(cells.size()); }

@@ -110,14 +110,10 @@ MapFeatures Reassembler::build() const {
   stack.seen = seenOf(a);
   std::vector<SliceFeatures> sent_as_features;
   for (const auto& [index, parts] : done_) {
-    if (parts.front().encoding() == wire::SliceEncoding::OCCUPANCY) {
+    if (parts.front().encoding() == wire::SliceEncoding::OCCUPANCY)
       stack.cells[static_cast<size_t>(index)] = cells_.at(index);
-    } else {
+    else
       sent_as_features.push_back(featuresFromWire(index, parts, stack.grid));
-      // Its cells are not here: unseen, so that a pose landed on the rest
-      // reads no empty space where the peer saw walls (dense_search.cpp, Enclosure).
-      stack.seen[static_cast<size_t>(index)] = false;
-    }
   }
   stack.partial = !sent_as_features.empty();
   MapFeatures out = extractFeatures(std::move(stack), featureParamsOf(a));

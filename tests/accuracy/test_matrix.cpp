@@ -158,7 +158,7 @@ TEST(RegressionMatrix, NoFamilyAnswersWrongOrFewerRightThanItsFloor) {
     EXPECT_EQ(j["height_offset_slices"], judged["refined"]["height_offset_slices"]);
     const auto& pose = j["T_target_source"];
     const auto& at = judged["refined"];
-    if (!j["finish"].value("held", false)) {
+    if (!(j["finish"].is_object() && j["finish"].value("held", false))) {
       EXPECT_NEAR(pose["x"].get<double>(), at["x"].get<double>(), 1e-6);
       EXPECT_NEAR(pose["y"].get<double>(), at["y"].get<double>(), 1e-6);
       EXPECT_NEAR(std::remainder(pose["yaw"].get<double>() - at["yaw"].get<double>(), 2 * M_PI), 0.0, 1e-6);
@@ -167,5 +167,7 @@ TEST(RegressionMatrix, NoFamilyAnswersWrongOrFewerRightThanItsFloor) {
       EXPECT_LE(j["finish"]["moved_m"].get<double>(), 8 * j["grid"].get<double>()) << j["finish"].dump();
     }
   }
-  EXPECT_GE(answers, 150) << "the matrix's answers were read";
+  int reliable = 0;
+  for (const auto& [family, t] : got) reliable += t.right + t.wrong;
+  EXPECT_EQ(answers, reliable) << "every answer's JSON was read";
 }
