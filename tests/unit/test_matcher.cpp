@@ -182,9 +182,9 @@ TEST(Matcher, AnUpdateDescribedOnItsEarlierVersionRunsOrbOnlyWhereItChanged) {
 
 // A daemon's peer map holds some slices as features, not cells, where
 // those were the cheaper to send (SliceStack::partial; a map small enough
-// for a dense search travels as cells throughout). The slices without cells
-// are unseen: the candidates land on the rest, and the decision answers on
-// them, without a dense search.
+// for a dense search travels as cells throughout). The candidates land on
+// the cells that came, and the decision answers on them, without a dense
+// search.
 TEST(Matcher, AMapWithSomeSlicesSentAsFeaturesIsAnsweredOnTheCellsItHas) {
   synth::SceneParams sp;  // the full-size building: its slices cross as cells or features, whichever is smaller
   const auto maps = synth::scanScene(synth::makeScene(sp), synth::noiseLevel("low"), sp.seed);
@@ -194,8 +194,7 @@ TEST(Matcher, AMapWithSomeSlicesSentAsFeaturesIsAnsweredOnTheCellsItHas) {
   MapFeatures source = describeMap(maps[1].points, p);
   SliceStack& o = source.occupancy;  // as the reassembler leaves it, every other slice sent as features
   o.partial = true;
-  o.seen.assign(o.cells.size(), true);
-  for (size_t k = 0; k < o.cells.size(); k += 2) o.cells[k].clear(), o.seen[k] = false;
+  for (size_t k = 0; k < o.cells.size(); k += 2) o.cells[k].clear();
   const MatchResult r = matchFeatures(target, source, p);
   ASSERT_TRUE(r.reliable) << r.reason;
   EXPECT_GE(r.lead_sigma, kBars.significant);
