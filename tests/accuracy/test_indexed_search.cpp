@@ -97,10 +97,11 @@ void expectGeneratedWorldsAnswerAlike(uint64_t first, uint64_t last) {
       }
 }
 
-// The default run checks the corners and the first eight random moves, and
+// The default run checks the corners and the first two random moves, and
 // seed 1 of every world at every noise; the `large` label (LargeIndexedSearch)
-// the rest.
-constexpr size_t kDemoRoomMovesInCi = 12;
+// the rest (a match that runs every dense search takes about a second on the
+// demo room, twice here).
+constexpr size_t kDemoRoomMovesInCi = 6;
 constexpr uint64_t kSeedsInCi = 1;
 
 }  // namespace
