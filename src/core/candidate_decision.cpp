@@ -86,9 +86,9 @@ std::pair<double, int> occupancyLead(const SliceScores& a, const SliceScores& b)
 }
 
 /// Votes `a`'s lead over votes `b` (Candidate::feature_votes, by source
-/// slice), over the source slices where either has one, by signFlipLeadSigma: the counts are small
-/// and often the same from slice to slice, where a t reads any lead over
-/// two slices as certain.
+/// slice), over the source slices where either has one, by
+/// signFlipLeadSigma: the counts are small and often the same from slice to
+/// slice, where a t reads any lead over two slices as certain.
 std::pair<double, int> votesLead(const std::vector<int>& a, const std::vector<int>& b) {
   std::vector<double> d;
   const size_t n = std::max(a.size(), b.size());
@@ -185,10 +185,10 @@ bool byVotes(CandidateVerdict& v, const std::vector<Candidate>& candidates, cons
     return false;
   }
   // With no candidate elsewhere, nothing elsewhere has a vote.
+  static const std::vector<int> kNoVotes;
   const int other = bestElsewhere(voted, agreed_more);
-  const std::pair<double, int> by_votes =
-      votesLead(candidates[voted].feature_votes,
-                other < 0 ? std::vector<int>{} : candidates[static_cast<size_t>(other)].feature_votes);
+  const std::pair<double, int> by_votes = votesLead(
+      candidates[voted].feature_votes, other < 0 ? kNoVotes : candidates[static_cast<size_t>(other)].feature_votes);
   v.reason += "; the candidate most slice pairs agree with leads " +
               std::string(other < 0 ? "no votes elsewhere (no candidate is)" : "the most agreed-with elsewhere") +
               " by " + fixed(by_votes.first, 1) + " sigma over " + std::to_string(by_votes.second) + " source slices";

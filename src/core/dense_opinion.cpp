@@ -131,7 +131,6 @@ void climbUphill(MatchResult& r, const PoseLander& land, const std::vector<std::
     if (onePlace(T, offset, answer, r.height_offset, same, source.occupancy.grid.centre()))
       starts.emplace_back(T, offset);
   const std::vector<DensePose> landed = land(starts);
-  if (landed.empty()) return;
   const DensePose* start = &landed.front();
   for (const DensePose& p : landed)
     if (p.score() > start->score() && significance(p.score(), landed.front().score()) >= kBars.significant) start = &p;

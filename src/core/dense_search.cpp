@@ -547,10 +547,7 @@ std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& sou
   return PoseLander(target, source, params)(poses);
 }
 
-DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset) {
-  const std::vector<DensePose> landed = land({{T, offset}});
-  return landed.empty() ? DensePose{T, offset, 0} : landed.front();
-}
+DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset) { return land({{T, offset}}).front(); }
 
 DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                    const DenseSearchParams& params) {

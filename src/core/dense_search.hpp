@@ -157,8 +157,7 @@ class PoseLander {
   std::function<int(const Rigid2D&, int, int)> height_;
 };
 
-/// landPose with a lander: (T, offset) landed, nothing landed (all counts 0)
-/// where `land` lands nothing.
+/// landPose with a lander: (T, offset) landed.
 DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset);
 
 /// Correlates the maps' occupancy on a coarse raster at every yaw step, shift

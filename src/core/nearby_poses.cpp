@@ -49,7 +49,6 @@ DensePose climb(const PoseLander& land, const SliceGrid& source, double cell, co
   for (int step = 0; step < kMaxSteps; ++step) {
     const PoseLander::Poses steps = stepsFrom(T, offset, cell, yaw_step, source.centre());
     const std::vector<double> scores = land.scores(steps);
-    if (scores.empty()) break;
     const size_t next = best(scores);
     if (scores[next] <= score) break;
     T = steps[next].first, offset = steps[next].second, score = scores[next], moved = true;
