@@ -3,8 +3,8 @@
 #include <chrono>
 
 #include "core/height_offsets.hpp"
+#include "core/lead_sigma.hpp"
 #include "core/offset_search.hpp"
-#include "core/verdict.hpp"
 
 namespace tomomap::baseline {
 

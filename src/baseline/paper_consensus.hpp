@@ -2,7 +2,7 @@
 // The paper's method as published (Unlu et al., its "Consensus" matcher):
 // slices, ORB, a rigid 2D estimate per slice pair, the consensus of each
 // height offset, and the offset with the most agreeing slice pairs. No
-// verdict: it answers whenever any slice pair gave an estimate, as the
+// decision: it answers whenever any slice pair gave an estimate, as the
 // paper's code does. Evaluations run it beside tomomap to count the pairs
 // the plain method answers right that tomomap refuses, and the ones it
 // answers wrong.

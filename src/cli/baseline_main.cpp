@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
   CLI::App app{"tomomap-baseline " TOMOMAP_VERSION
                ": the methods tomomap is measured against.\n"
                "  fpfh-ransac: FPFH features on keypoints + RANSAC (PCL), radii scaled from the grid size.\n"
-               "  paper-consensus: the paper's tomographic method as published, without tomomap's verdict:\n"
+               "  paper-consensus: the paper's tomographic method as published, without tomomap's decision:\n"
                "    the height offset with the most agreeing slice pairs, whatever their number.\n"
                "Exit codes: 0 converged, 1 no reliable match, 2 bad input, 3 internal error.",
                "tomomap-baseline"};

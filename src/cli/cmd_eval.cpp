@@ -44,10 +44,6 @@ struct Row {
          peak_rss_mb = 0;
   double features = 0, slices = 0, payload_bytes = 0, raw_bytes = 0;
   std::string note;
-  /// With --decision verdict --candidates: what the decision over the
-  /// candidates, beside the verdict, gives: "right", "wrong" or "refused";
-  /// empty where it did not run or answered itself.
-  std::string candidate_decision;
 };
 
 const char* kCsvHeader =
@@ -78,10 +74,9 @@ std::string fileNameOf(std::string name) {
 }
 
 /// One run of `method` on `p`; with `candidates`, tomomap lists its
-/// candidates and the run's JSON is kept as OUT/results/PAIR.METHOD.json;
-/// tomomap answers by `decision` (tomomap match --decision).
+/// candidates and the run's JSON is kept as OUT/results/PAIR.METHOD.json.
 Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratch, int threads, double timeout_s,
-           bool candidates, const std::string& decision) {
+           bool candidates) {
   Row row;
   row.pair = p.name;
   row.noise = p.noise;
@@ -96,7 +91,6 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
   else
     argv = {siblingBinary("tomomap-baseline"), "--method", method};
   if (method == "tomomap" && candidates) argv.push_back("--candidates");
-  if (method == "tomomap") argv.insert(argv.end(), {"--decision", decision});
   for (const auto& a : {p.target, p.source, std::string("--grid"), std::to_string(p.grid), std::string("--json"), json,
                         std::string("--gt-target"), p.gt_target, std::string("--gt-source"), p.gt_source,
                         std::string("-j"), std::to_string(threads)})
@@ -129,22 +123,6 @@ Row runOne(const SuitePair& p, const std::string& method, const fs::path& scratc
     row.success = j["error"]["success"];
   }
   if (!row.reliable) row.note = j.value("reason", "");
-  // The decision over the candidates beside the verdict; where it answers,
-  // its outcome is the row's own.
-  if (j.contains("candidate_decision") && j.value("decision", "") != decisionName(Decision::candidates)) {
-    const auto& answer = j["candidate_decision"]["answer"];
-    if (answer.is_null()) {
-      row.candidate_decision = "refused";
-    } else {
-      // Judged as the verdict's answer is: finished in 6-DoF where the finish held.
-      const auto& trial = j["candidate_decision"];
-      const nlohmann::json picked =
-          trial.contains("finished_error")
-              ? trial["finished_error"]
-              : j["candidates"].at(answer.get<size_t>()).value("error", nlohmann::json::object());
-      row.candidate_decision = picked.value("success", false) ? "right" : "wrong";
-    }
-  }
   const auto& s = j["slices"];
   row.features = s.value("target_features", 0.0) + s.value("source_features", 0.0);
   row.slices = s.value("target", 0.0) + s.value("source", 0.0);
@@ -202,25 +180,6 @@ std::string summary(const std::string& suite, const std::vector<Row>& rows, cons
   for (const auto& [key, f] : families)
     o << "| " << key.first << " | " << key.second << " | " << f[0] + f[1] + f[2] + f[3] << " | " << f[0] << " | "
       << f[1] << " | " << f[2] << " | " << f[3] << " |\n";
-  // With --decision verdict --candidates: the decision over the candidates beside the verdict's answers.
-  std::map<std::string, std::array<int, 4>> trial;  // the verdict's right; the trial's right, refused, wrong
-  for (const auto& r : rows)
-    if (!r.candidate_decision.empty()) {
-      auto& t = trial[r.family];
-      t[0] += r.success;
-      ++t[r.candidate_decision == "right" ? 1 : r.candidate_decision == "refused" ? 2 : 3];
-    }
-  if (!trial.empty()) {
-    o << "\nOne decision over the candidates, beside the verdict (docs/algorithm.md; its answer is judged as the "
-         "verdict's, after the 6-DoF finish where that holds):\n\n| family | the verdict's right | the decision: "
-         "right | refused | wrong |\n|---|---|---|---|---|\n";
-    std::array<int, 4> sum{};
-    for (const auto& [family, t] : trial) {
-      o << "| " << family << " | " << t[0] << " | " << t[1] << " | " << t[2] << " | " << t[3] << " |\n";
-      for (size_t i = 0; i < 4; ++i) sum[i] += t[i];
-    }
-    o << "| all | " << sum[0] << " | " << sum[1] << " | " << sum[2] << " | " << sum[3] << " |\n";
-  }
   if (!skipped.empty()) {
     o << "\nSkipped (no pair to match, not counted above):\n";
     for (const auto& s : skipped) o << "- " << s << "\n";
@@ -260,13 +219,6 @@ cv::Mat boxPlots(const std::vector<Row>& rows, const std::vector<std::string>& m
       {viz::stack({drawBoxPanel(t), drawBoxPanel(y)}, false), viz::stack({drawBoxPanel(w), drawBoxPanel(m)}, false)});
 }
 
-/// Every decision's name (tomomap match --decision).
-std::vector<std::string> decisionNames() {
-  std::vector<std::string> out;
-  for (const Decision d : kDecisions) out.emplace_back(decisionName(d));
-  return out;
-}
-
 struct EvalOptions {
   std::string suite, out = "eval-out";
   SuiteSequence sequence;  ///< a user's own posed sequence, instead of a suite (--scans, --poses)
@@ -275,7 +227,6 @@ struct EvalOptions {
   int threads = 0;
   double timeout_s = 0;     ///< per run; 0 = none
   bool candidates = false;  ///< tomomap's runs list their candidates; every run's JSON kept in OUT/results
-  std::string decision = decisionName(MatchParams{}.decision);  ///< what answers tomomap's runs (match --decision)
 };
 
 /// The suite a user's own posed sequence stands for: `pairs` seeds of it, tomomap alone.
@@ -411,35 +362,34 @@ int runEval(const EvalOptions& o) {
     for (const auto& m : methodsOf(p)) {
       // Said before it starts: a baseline run can take minutes.
       std::cerr << "[" << rows.size() + 1 << "/" << total << "] " << p.name << " " << m << ": running\n";
-      Row r = runOne(p, m, out, o.threads, o.timeout_s, o.candidates, o.decision);
+      Row r = runOne(p, m, out, o.threads, o.timeout_s, o.candidates);
       rows.push_back(r);
       // Written as they finish: an interrupted run keeps every finished row.
       rows_csv << csv(r) << std::endl;
-      rows_json
-          << nlohmann::json{{"schema_version", kJsonSchemaVersion},
-                            {"pair", r.pair},
-                            {"noise", r.noise},
-                            {"family", r.family},
-                            {"method", r.method},
-                            {"exit_code", r.exit_code},
-                            {"reliable", r.reliable},
-                            {"success", r.success},
-                            {"translation_error_m",
-                             std::isnan(r.translation_error) ? nlohmann::json() : nlohmann::json(r.translation_error)},
-                            {"translation_error_at_origin_m",
-                             std::isnan(r.origin_error) ? nlohmann::json() : nlohmann::json(r.origin_error)},
-                            {"yaw_error_rad", std::isnan(r.yaw_error) ? nlohmann::json() : nlohmann::json(r.yaw_error)},
-                            {"wall_s", r.seconds},
-                            {"cpu_s", r.cpu_seconds},
-                            {"peak_rss_mb", r.peak_rss_mb},
-                            {"features", r.features},
-                            {"feature_payload_bytes", r.payload_bytes},
-                            {"raw_map_bytes", r.raw_bytes},
-                            {"note", r.note},
-                            {"candidate_decision",
-                             r.candidate_decision.empty() ? nlohmann::json() : nlohmann::json(r.candidate_decision)}}
-                 .dump()
-          << std::endl;
+      rows_json << nlohmann::json{{"schema_version", kJsonSchemaVersion},
+                                  {"pair", r.pair},
+                                  {"noise", r.noise},
+                                  {"family", r.family},
+                                  {"method", r.method},
+                                  {"exit_code", r.exit_code},
+                                  {"reliable", r.reliable},
+                                  {"success", r.success},
+                                  {"translation_error_m", std::isnan(r.translation_error)
+                                                              ? nlohmann::json()
+                                                              : nlohmann::json(r.translation_error)},
+                                  {"translation_error_at_origin_m",
+                                   std::isnan(r.origin_error) ? nlohmann::json() : nlohmann::json(r.origin_error)},
+                                  {"yaw_error_rad",
+                                   std::isnan(r.yaw_error) ? nlohmann::json() : nlohmann::json(r.yaw_error)},
+                                  {"wall_s", r.seconds},
+                                  {"cpu_s", r.cpu_seconds},
+                                  {"peak_rss_mb", r.peak_rss_mb},
+                                  {"features", r.features},
+                                  {"feature_payload_bytes", r.payload_bytes},
+                                  {"raw_map_bytes", r.raw_bytes},
+                                  {"note", r.note}}
+                       .dump()
+                << std::endl;
       std::cerr << "[" << rows.size() << "/" << total << "] " << std::left << std::setw(28) << p.name << " "
                 << std::setw(12) << m
                 << (r.success          ? "success"
@@ -504,9 +454,6 @@ Command addEvalCommand(CLI::App& app) {
   sub->add_flag("--candidates", o->candidates,
                 "tomomap lists every candidate pose (tomomap match --candidates) and each run's JSON is kept in "
                 "OUT/results/: what the decision could have answered, pair by pair");
-  sub->add_option("--decision", o->decision, "what answers tomomap's runs (tomomap match --decision)")
-      ->capture_default_str()
-      ->check(CLI::IsMember(decisionNames()));
   return {sub, [o] { return runEval(*o); }};
 }
 

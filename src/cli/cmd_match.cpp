@@ -14,8 +14,7 @@ Command addMatchCommand(CLI::App& app) {
   sub->footer("Exit codes: 0 reliable match, 1 no reliable match, 2 bad input, 3 internal error.");
   return {sub, [o] {
             const MatchedFiles m = matchFiles(*o);
-            return report(m.result, m.truth, o->params.grid, {o->json, "tomomap", o->quiet, o->params.candidates},
-                          m.inputs);
+            return report(m.result, m.truth, o->params.grid, {o->json, "tomomap", o->quiet, o->candidates}, m.inputs);
           }};
 }
 

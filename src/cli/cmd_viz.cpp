@@ -26,7 +26,7 @@ int runViz(const VizOptions& o) {
   const double g = o.files.params.grid;
   std::optional<GroundTruthCheck> gt;
   if (m.truth) gt = checkAgainstGroundTruth(r, *m.truth, g);
-  const int code = report(r, m.truth, g, {o.files.json, "tomomap", o.files.quiet, o.files.params.candidates}, m.inputs);
+  const int code = report(r, m.truth, g, {o.files.json, "tomomap", o.files.quiet, o.files.candidates}, m.inputs);
 
   const auto& T = r.T_target_source;
   std::vector<std::string> caption{

@@ -144,16 +144,9 @@ void addMatchOptions(CLI::App& sub, MatchFilesOptions& o) {
                        "gravity estimate): not estimated then, and the map levelled by it")
         ->expected(3)
         ->delimiter(',');
-  sub.add_flag("--candidates", o.params.candidates,
+  sub.add_flag("--candidates", o.candidates,
                "list every pose the searches proposed, refined and scored on the occupancy, with its error "
                "where ground truth is given");
-  std::map<std::string, Decision> decisions;
-  for (const Decision d : kDecisions) decisions[decisionName(d)] = d;
-  sub.add_option("--decision", o.params.decision,
-                 "what answers: the one decision over the candidates, or the verdict it replaced (kept for "
-                 "comparison)")
-      ->transform(CLI::CheckedTransformer(decisions))
-      ->default_str(decisionName(MatchParams{}.decision));
   sub.add_flag("--exhaustive", o.params.exhaustive,
                "match every slice pair instead of the height offsets the descriptor index points to "
                "(same answers, n^2 cost; for checking)");

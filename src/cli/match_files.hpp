@@ -18,6 +18,7 @@ struct MatchFilesOptions {
   /// Each map's up direction where the user knows it (x, y, z in the map's frame; empty: estimated).
   std::vector<double> up_target, up_source;
   bool progress = false, quiet = false;
+  bool candidates = false;  ///< list every candidate pose (--candidates)
 };
 
 struct MatchedFiles {
@@ -34,7 +35,7 @@ struct MatchedFiles {
 MatchedFiles matchFiles(MatchFilesOptions o);
 
 /// Adds --grid, --json, --gt-target, --gt-source, --features, -j, --max-tilt, --level, --up-target, --up-source,
-/// --exhaustive, --progress, -q.
+/// --candidates, --exhaustive, --progress, -q.
 void addMatchOptions(CLI::App& sub, MatchFilesOptions& o);
 
 }  // namespace tomomap::cli

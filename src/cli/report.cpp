@@ -92,8 +92,7 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
       out << format("dense search     at the map's cells its best pose leads the next by %.2fx\n", d.at_grid_lead);
     if (d.pooled_lead > 0)
       out << format("                 on occupancy pooled to twice the cell: %.2fx\n", d.pooled_lead);
-    if (d.wide_lead > 0)
-      out << format("                 on a raster twice as fine, checking the features' answer: %.2fx\n", d.wide_lead);
+    if (d.wide_lead > 0) out << format("                 on a raster twice as fine: %.2fx\n", d.wide_lead);
     if (d.second_look_apart)
       out << format("                 with the maps' roles swapped, the source's origin %.3f m from its pose\n",
                     *d.second_look_apart);
@@ -283,18 +282,16 @@ void listCandidates(std::ostream& out, const MatchResult& r,
   }
 }
 
-/// What the decision over the candidates said: its answer, and what it
-/// answered on, or why it has none.
-void printDecision(std::ostream& out, const MatchResult& r, const std::optional<GroundTruthCheck>& finished_check) {
+/// What the decision over the candidates said: the candidate it answered
+/// and what it answered on, or why it has none.
+void printDecision(std::ostream& out, const MatchResult& r) {
   const CandidateVerdict& v = *r.candidate_verdict;
-  const char* role = r.decision == Decision::candidates ? "(the answer)" : "(beside the verdict, not the answer)";
   if (v.answer < 0)
-    out << "one decision     " << role << " no reliable match: " << v.reason << "\n";
+    out << "decision         no reliable match: " << v.reason << "\n";
   else
-    out << format("one decision     %s %s (%d), %.1f sigma clear on %s over %d slices\n", role,
+    out << format("decision         candidate %s (%d), %.1f sigma clear on %s over %d slices\n",
                   fromName(r.candidates[static_cast<size_t>(v.answer)].from),
                   r.candidates[static_cast<size_t>(v.answer)].rank, v.lead_sigma, onName(v.on), v.slices);
-  if (finished_check) out << "                 finished in 6-DoF: " << candidateErrorText(*finished_check) << "\n";
 }
 
 }  // namespace
@@ -304,9 +301,6 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
   std::optional<GroundTruthCheck> gt;
   if (truth) gt = checkAgainstGroundTruth(r, *truth, grid);
   const std::vector<std::optional<GroundTruthCheck>> checks = candidateChecks(r, truth, grid);
-  std::optional<GroundTruthCheck> finished_check;  // the decision's answer, finished
-  if (truth && r.candidate_verdict && r.candidate_verdict->finished)
-    finished_check = checkAgainstGroundTruth(*r.candidate_verdict->finished, *truth, grid);
   const bool json_to_stdout = how.json == "-";
   std::ostream& text = json_to_stdout ? std::cerr : std::cout;
   if (how.quiet)
@@ -314,13 +308,12 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
   else
     printResult(text, r, gt, how.method);
   if (!how.quiet && how.candidates && !r.candidates.empty()) listCandidates(text, r, checks);
-  if (!how.quiet && r.candidate_verdict) printDecision(text, r, finished_check);
+  if (!how.quiet && r.candidate_verdict) printDecision(text, r);
   if (!how.json.empty()) {
     auto j = toJson(r, gt);
     j["schema_version"] = kJsonSchemaVersion;
     j["tool"] = {{"name", how.method == "tomomap" ? "tomomap" : "tomomap-baseline"}, {"version", TOMOMAP_VERSION}};
     j["method"] = how.method;
-    if (how.method == "tomomap") j["decision"] = decisionName(r.decision);
     j["grid"] = grid;
     if (extra.is_object()) j.update(extra);
     if (how.candidates && !r.candidates.empty()) j["candidates"] = candidatesJson(r, checks);
@@ -332,8 +325,6 @@ int report(const MatchResult& r, const std::optional<GroundTruth>& truth, double
                                  {"slices", v.slices},
                                  {"compared_at", {v.compared_at.x(), v.compared_at.y()}}};
       if (v.answer < 0) j["candidate_decision"]["reason"] = v.reason;
-      if (v.finished) j["candidate_decision"]["finished"] = true;
-      if (finished_check) j["candidate_decision"]["finished_error"] = candidateErrorJson(*finished_check);
     }
     if (json_to_stdout) {
       std::cout << j.dump(2) << "\n";

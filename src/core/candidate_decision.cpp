@@ -10,6 +10,31 @@
 #include "text.hpp"
 
 namespace tomomap {
+
+double contradiction(const DensePose& p) {
+  return static_cast<double>(p.contradicted) / static_cast<double>(std::max<size_t>(p.telling_inliers, 1));
+}
+
+bool consistent(const DensePose& p) { return contradiction(p) <= kBars.most_contradicted; }
+
+bool holdsOver(const DensePose& p, int min_support) { return consistent(p) && p.support >= min_support; }
+
+double looksApart(const MatchParams& params, double grid) {
+  return std::sqrt(2.0) * params.consensus_translation_cells * grid;
+}
+
+double DenseEvidence::lead() const { return best.score() <= 0 ? 0 : best.score() / std::max(next_score, 1.0); }
+
+double DenseEvidence::leadSigma() const { return significance(best.score(), next_score); }
+
+bool beyondChance(const DenseEvidence& d) { return d.found && d.leadSigma() >= kBars.significant; }
+
+bool aheadBeyondChance(const DenseEvidence& d, double by) { return beyondChance(d) && d.lead() >= by; }
+
+bool leads(const DenseEvidence& d, double by, const MatchParams& params) {
+  return aheadBeyondChance(d, by) && holdsOver(d.best, params.min_support);
+}
+
 namespace {
 
 /// Per slice: what a candidate lands there (telling cells, less those in
@@ -206,12 +231,11 @@ bool byVotes(CandidateVerdict& v, const std::vector<Candidate>& candidates, cons
   return true;
 }
 
-/// The decision's last step (decideOnCandidates): a search that answers
-/// alone in the verdict (at the grid, pooled) whose own best pose lies at
+/// The decision's last step (decideOnCandidates): a search on the maps' own
+/// cells (at the grid, pooled) whose own best pose lies at
 /// the place of `best`, the candidate that lands the most, clear of its
 /// next, answers that pose (its candidate, climbed) where it finds it again
-/// with the maps' roles swapped: the verdict's evidence for such a pose,
-/// read in the decision's terms. The occupancy's slices may not tell a
+/// with the maps' roles swapped. The occupancy's slices may not tell a
 /// room's right place from a copy of it a wall along (rooms at g 0.1:
 /// 2.5-2.9 sigma), where the whole occupancy, searched both ways, does. The
 /// pose found twice is the pose answered, not another at its place that
@@ -224,9 +248,8 @@ bool byVotes(CandidateVerdict& v, const std::vector<Candidate>& candidates, cons
 /// (sunrgbd-room-once-wrong-200, g 0.05) the pooled search's best led 1.62x
 /// and was found again, and was wrong; the grid's best lay elsewhere, 1.96x
 /// ahead (docs/results.md, "Other tests for the decision, replayed"). Found
-/// again is at the same place (SecondLook::same_place), without the
-/// verdict's further bar on where the two looks put the source's origin
-/// (looksApart): the suites were measured so.
+/// again is at the same place (SecondLook::same_place), with no further bar
+/// on where the two looks put the source's origin: the suites were measured so.
 void bySecondLook(CandidateVerdict& v, const std::vector<Candidate>& candidates, size_t at,
                   const std::vector<SearchLead>& searches, const MatchParams& params, const ConsensusParams& tolerance,
                   const Eigen::Vector2d& centre) {
@@ -334,13 +357,14 @@ const char* onName(CandidateVerdict::On on) {
   return "?";
 }
 
-CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, const MatchParams& params, double grid,
-                                    const Eigen::Vector2d& source_centre, const std::vector<SearchLead>& searches) {
-  const ConsensusParams tolerance = consensusParams(params, grid);
+CandidateVerdict decideOnCandidates(const DecisionEvidence& e, const MatchParams& params) {
+  const std::vector<Candidate>& candidates = e.candidates;
+  const Eigen::Vector2d& source_centre = e.source_centre;
+  const ConsensusParams tolerance = consensusParams(params, e.grid);
   const auto samePlace = [&](const Candidate& a, const Candidate& b) {
     return onePlace(a.landed.transform, a.landed.offset, b.landed.transform, b.landed.offset, tolerance, source_centre);
   };
-  CandidateVerdict v = decidePlace(candidates, params, tolerance, source_centre, searches, samePlace);
+  CandidateVerdict v = decidePlace(candidates, params, tolerance, source_centre, e.searches, samePlace);
   // A second look answers the pose its search found twice, not the best at its place.
   if (v.answer >= 0 && v.on != CandidateVerdict::On::second_look)
     v.answer = static_cast<int>(finestAt(candidates, static_cast<size_t>(v.answer), samePlace));

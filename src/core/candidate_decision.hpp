@@ -1,16 +1,99 @@
 #pragma once
-// One decision over the candidates, which answers a match (the verdict it
-// replaced, verdict.hpp, is kept beside it for comparison): the best
-// candidate answers when its lead over the best candidate elsewhere, slice
-// by slice, is beyond chance (docs/algorithm.md, "One decision").
+// The one decision that answers a match: the best candidate answers when its
+// lead over the best candidate elsewhere, slice by slice, is beyond chance
+// (docs/algorithm.md, "One decision"). Its evidence record, the bars it
+// holds that evidence to (the one place they are stated), and the measures
+// of a landed pose it reads.
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "candidates.hpp"
-#include "verdict.hpp"
+#include "dense_search.hpp"
+#include "match_params.hpp"
 
 namespace tomomap {
+
+/// Every bar the decision uses, each with its unit and how it was derived:
+/// the one place they are stated. (What the bars measure is defined where it
+/// is computed: a pose's score in dense_search.hpp, the leads' tests in
+/// lead_sigma.hpp, the smear of heights in height_offsets.hpp, the user's
+/// settings in match_params.hpp.)
+struct DecisionBars {
+  /// A lead counts only this many standard deviations beyond chance: one-sided,
+  /// 0.13 %. On the matrix's 316 pairs no lower bar answered fewer wrong, and
+  /// the decision is not tuned below it (docs/results.md, "Candidates on the
+  /// matrix"). On a real RGB-D room (sunrgbd-room-2 at g 0.1) the pooled
+  /// search's best pose led 13 to 7 (1.3 sigma) and was 13.9 m off; right
+  /// answers on rooms lead by tens of sigma.
+  double significant = 3.0;  ///< [standard deviations]
+  /// A corroborated pose that lands more than this share as many telling
+  /// cells in space the other map saw empty as on its occupancy is not
+  /// corroborated: the corroborated right answers of all four suites landed at
+  /// most 0.13; a room whose right pose no search proposed (seed 208, high
+  /// noise, g 0.1) was corroborated 2.67 m off at 0.24 (docs/results.md, "A
+  /// corroborated pose the empty space contradicts").
+  double most_contradicted = 0.2;  ///< [share of telling cells landed]
+  /// A dense search's best pose answers on its second look only where it
+  /// scores this many times its next pose, and a search's best pose that far
+  /// ahead elsewhere tells against any such answer. Room pairs (synth -w
+  /// room, seeds 1-10, every noise, g 0.1 and 0.05), ranked by telling cells
+  /// alone: wrong best poses led by 1.00-1.33, right ones by 1.04-3.37; with
+  /// empty space read (seeds 1-100, low and high noise, g 0.1; and pooled from
+  /// g 0.05) wrong ones led by at most 1.14.
+  double dense_lead = 1.4;  ///< [ratio of scores]
+  /// Pooled occupancy is searched only where its cell stays this fine (maps
+  /// at g 0.1 and finer): room pairs were measured up to there.
+  double coarsest_pooled_cell = 0.2;  ///< [m]
+};
+inline constexpr DecisionBars kBars{};
+
+/// A pose's telling cells in the other map's empty space, per one landed on its occupancy.
+double contradiction(const DensePose& p);
+/// Whether a pose contradicts no more than kBars.most_contradicted.
+bool consistent(const DensePose& p);
+/// Whether a pose is consistent over at least `min_support` slices.
+bool holdsOver(const DensePose& p, int min_support);
+
+/// How far apart two looks at one pose (two proposals of it, or one search
+/// with the maps' roles swapped) may place it and still be looks at one
+/// place [m]: two looks of equal spread lie sqrt(2) times one's error apart,
+/// so within sqrt(2) consensus tolerances, each is within the tolerance.
+double looksApart(const MatchParams& params, double grid);
+
+/// What one dense search says of its own best pose: how far ahead of its next.
+struct DenseEvidence {
+  bool found = false;     ///< searched, and found at least one pose
+  DensePose best;         ///< its best pose (found only)
+  double next_score = 0;  ///< its next pose's score; 0 if it found one only
+  double cell = 0;        ///< of the occupancy searched [m]
+
+  /// The best pose's score over its next's; 0 where even the best contradicts more than it finds.
+  double lead() const;
+  /// The same lead in sigmas of chance (significance): how far beyond what
+  /// two poses alike would score apart.
+  double leadSigma() const;
+};
+
+/// Whether a search found a best pose ahead of its next beyond chance
+/// (kBars.significant), by whatever ratio.
+bool beyondChance(const DenseEvidence& d);
+/// Whether a search found a best pose that leads its next by `by`, beyond
+/// chance (kBars.significant).
+bool aheadBeyondChance(const DenseEvidence& d, double by);
+/// The same, its best pose holding over min_support slices (holdsOver).
+bool leads(const DenseEvidence& d, double by, const MatchParams& params);
+
+/// The search whose best pose would answer, asked again with the maps' roles
+/// swapped (the target's cells landed on the source's raster): a second look
+/// at the same occupancy, its best pose turned back to map the source onto
+/// the target.
+struct SecondLook {
+  bool found = false;  ///< it found a pose
+  /// That pose is the search's best (the same place at the source's centre, within the smear of heights).
+  bool same_place = false;
+  double apart = 0;  ///< where the two put the source's frame origin, apart [m]
+};
 
 /// What the decision over the candidates says.
 struct CandidateVerdict {
@@ -31,10 +114,6 @@ struct CandidateVerdict {
   /// Where two candidates' places were compared: the source raster's centre,
   /// in the source's frame [m].
   Eigen::Vector2d compared_at = Eigen::Vector2d::Zero();
-  /// The answer finished in 6-DoF as the verdict's answer is (six_dof_finish.hpp),
-  /// as the whole transform between the maps' own frames; unset where the
-  /// finish did not run or did not hold.
-  std::optional<Eigen::Matrix4d> finished;
   /// The search whose second look would decide (SearchLead::look): look,
   /// and ask again. Unset once the decision has what it needs.
   std::optional<Candidate::From> needs_look;
@@ -52,9 +131,20 @@ struct SearchLead {
 
 const char* onName(CandidateVerdict::On on);
 
-/// The decision over `candidates` (refineAndLand's, for maps of `grid` whose
-/// source raster is centred at `source_centre`). Two candidates are at the same
-/// place within one consensus tolerance at that centre, the consensus yaw and
+/// Everything the decision weighs: the one record it is a function of.
+struct DecisionEvidence {
+  /// Every pose the searches proposed, refined and landed (refineAndLand).
+  std::vector<Candidate> candidates;
+  /// What each dense search that ran says of its own best pose.
+  std::vector<SearchLead> searches;
+  double grid = 0;  ///< the maps' grid [m]
+  /// The source raster's centre, in the source's frame [m]: where two
+  /// candidates' places are compared.
+  Eigen::Vector2d source_centre = Eigen::Vector2d::Zero();
+};
+
+/// The decision on `e`. Two candidates are at the same place within one
+/// consensus tolerance at the source raster's centre, the consensus yaw and
 /// half the smear of heights. The candidate that lands the most (telling
 /// cells less twice the contradicted ones, slice by slice, on occupancy pooled
 /// to DenseSearchParams::finest_empty_cell where the grid is finer) answers if
@@ -65,14 +155,13 @@ const char* onName(CandidateVerdict::On on);
 /// the one the most slice-pair estimates agree with answers if it leads the
 /// most agreed-with elsewhere by kBars.significant, source slice by source slice,
 /// and no candidate elsewhere lands kBars.significant more; else the best
-/// pose of one of `searches` that answers alone in the verdict (at the
-/// grid, pooled) answers (its candidate) where it lies at the place of the
+/// pose of one of the searches on the maps' own cells (at the grid,
+/// pooled) answers (its candidate) where it lies at the place of the
 /// one that lands the most, leads its next by kBars.dense_lead beyond chance
 /// over min_support slices, no search's best pose elsewhere leads its next
 /// so, and that search's second look finds it again (asked for by
 /// needs_look). At the place the first three answer, the pose answered is
 /// the candidate there that lands the most on the maps' own cells, unpooled.
-CandidateVerdict decideOnCandidates(const std::vector<Candidate>& candidates, const MatchParams& params, double grid,
-                                    const Eigen::Vector2d& source_centre, const std::vector<SearchLead>& searches);
+CandidateVerdict decideOnCandidates(const DecisionEvidence& e, const MatchParams& params);
 
 }  // namespace tomomap

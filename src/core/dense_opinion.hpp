@@ -1,24 +1,39 @@
 #pragma once
-// The evidence the verdict asks for beyond the features (verdict.hpp): the
-// dense searches of small maps (dense_search.hpp), and the answer taken from
-// the search the verdict names.
+// From what the features proposed to the answer: the dense searches of small
+// maps (dense_search.hpp), every proposal made a candidate (candidates.hpp),
+// and the one decision over them (candidate_decision.hpp).
+#include <string>
+#include <vector>
+
+#include "candidate_decision.hpp"
 #include "matcher.hpp"
-#include "verdict.hpp"
 
 namespace tomomap {
 
-/// Settles `r` (matchFeatures' figures from the features, `e` their evidence)
-/// on the verdict: gathers what decideMatch asks for (the dense search at the
-/// maps' grid, the features' answer landed, the search on occupancy pooled to
-/// twice the cell, a second look at the pose that would answer), records each
-/// search's figures in `r`, and answers from the search the verdict names.
-/// Small maps get this second opinion because few slices and a 31-pixel ORB
-/// patch spanning most of the image leave the tomographic match refusing or,
-/// with noisy walls, fooled by a half-turned room or by one enclosure laid on a
-/// similar one, while the occupancy itself still tells the right pose apart.
-/// Whatever answers, a small map's answer then takes the height offset where
-/// the occupancy meets best. Larger maps are not searched.
-void settleMatch(MatchResult& r, Evidence& e, const MapFeatures& target, const MapFeatures& source,
+/// What the tomographic match (matcher.cpp) hands the decision beside the
+/// features' own answer in MatchResult.
+struct FeatureProposals {
+  /// Why the features proposed nothing (too few descriptive slices, no slice
+  /// pair estimated); empty when they did.
+  std::string missing;
+  /// Their distinct answers after the winner (rival_answers.hpp).
+  std::vector<Proposal> rivals;
+  /// Their slice-pair estimates that agree with a pose.
+  FeatureVotes votes;
+};
+
+/// Settles `r` (matchFeatures' figures from the features, `f` what else they
+/// proposed): the dense searches run where the maps are small enough (each
+/// its own reach), every pose proposed (the features' answer and rivals, the
+/// searches' best poses) is refined and landed as a candidate, and the
+/// decision over them (decideOnCandidates) answers, asking for a search's
+/// second look where that would decide. The pose answered is the candidate
+/// judged. Small maps get the dense searches because few slices and a
+/// 31-pixel ORB patch spanning most of the image leave the tomographic match
+/// refusing or, with noisy walls, fooled by a half-turned room or by one
+/// enclosure laid on a similar one, while the occupancy itself still tells
+/// the right pose apart.
+void settleMatch(MatchResult& r, const FeatureProposals& f, const MapFeatures& target, const MapFeatures& source,
                  const MatchParams& params);
 
 }  // namespace tomomap

@@ -42,12 +42,11 @@ struct DenseSearchParams {
 /// its coarse cell under a wall's thickness plus a furniture's width.
 constexpr int kMaxCoarsening = 6;
 
-/// The coarse raster's side for the search that checks a feature answer on
-/// too few slice pairs (verdict.hpp): twice the default's cells, so it reaches
-/// maps twice as large at the same coarse cell, and its cells on a LiDAR crop
-/// (340 cells at g 0.2) are 1.2 m, not 2.2 m, a road's width. Kept to that
-/// check: as the search for every small map it cost 4 of 10 right answers on
-/// streets at g 0.5 (a best pose too close to its next to confirm them).
+/// The coarse raster's side for the wide search (dense_opinion.cpp): twice
+/// the default's cells, so it reaches maps twice as large at the same coarse
+/// cell, and its cells on a LiDAR crop (340 cells at g 0.2) are 1.2 m, not
+/// 2.2 m, a road's width. Its best pose proposes candidates and corroborates
+/// one, but does not answer on its own second look (candidate_decision.cpp).
 /// Its coarse cell stays 2 grid cells or more: at 1, on rooms at g 0.1, it
 /// cost 2.5 times the usual search and confirmed no more.
 constexpr int kWideCoarseSide = 64;

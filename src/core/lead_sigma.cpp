@@ -67,4 +67,9 @@ double sliceLeadSigma(const std::vector<double>& differences) {
   return leadSigma(differences, independent);
 }
 
+double significance(double a, double b) {
+  a = std::max(a, 0.0), b = std::max(b, 0.0);
+  return (a - b) / std::sqrt(std::max(a + b, 1.0));
+}
+
 }  // namespace tomomap

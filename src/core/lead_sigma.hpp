@@ -29,4 +29,10 @@ double sliceLeadSigma(const std::vector<double>& differences);
 /// at or below zero.
 double signFlipLeadSigma(const std::vector<double>& differences);
 
+/// Count `a` over count `b` in standard deviations of a difference of two
+/// counts (each count's variance its own size, as for Poisson counts; a
+/// negative score counts as none): how far two poses' scores lie apart
+/// beyond chance.
+double significance(double a, double b);
+
 }  // namespace tomomap

@@ -7,15 +7,6 @@
 
 namespace tomomap {
 
-/// What answers a match: the one decision over the candidates
-/// (candidate_decision.hpp), or the verdict it replaced (verdict.hpp), kept
-/// for comparison until it is deleted.
-enum class Decision { verdict, candidates };
-
-/// A decision's name ("verdict", "candidates"), as the CLI and the JSON give it.
-inline const char* decisionName(Decision d) { return d == Decision::candidates ? "candidates" : "verdict"; }
-inline constexpr Decision kDecisions[] = {Decision::verdict, Decision::candidates};
-
 struct MatchParams {
   double grid = 0.05;  ///< voxel, pixel and slice size g [m]; 0.05 indoors, 0.2-0.5 outdoors
   FeatureParams features;
@@ -25,9 +16,12 @@ struct MatchParams {
   int min_matches = 5;                       ///< fewer mutual matches: the slice pair gives no estimate
   double consensus_translation_cells = 5.0;  ///< [grid cells]
   double consensus_yaw = radians(10.0);      ///< [rad]
-  int min_support = 3;                       ///< agreeing slice pairs needed for a reliable match
-  int min_inliers = 20;                      ///< inlier correspondences needed for a reliable match
-  int threads = 0;                           ///< threads one match uses; 0 = every core
+  /// Descriptive slices each map needs for the features to propose a pose,
+  /// and slices a dense search's best pose must hold over to answer on its
+  /// second look (candidate_decision.hpp); the margin of slice pairs by which
+  /// the indexed search follows a weak winner's rivals (offset_search.cpp).
+  int min_support = 3;  ///< [slices]
+  int threads = 0;      ///< threads one match uses; 0 = every core
   /// Match every slice pair instead of those at the height offsets a descriptor
   /// index votes for (offset_search.hpp): the same answers, at n^2 cost.
   bool exhaustive = false;
@@ -47,20 +41,7 @@ struct MatchParams {
   /// occupancy (six_dof_finish.hpp): the roll and pitch two imperfectly
   /// levelled maps leave between them.
   bool finish = true;
-  /// Record every candidate pose the searches propose, refined and landed on
-  /// the occupancy (MatchResult::candidates): what the decision could have
-  /// answered. Diagnostics: every search runs, seconds more on small maps.
-  bool candidates = false;
-  /// What answers (Decision): with Decision::candidates the candidates are
-  /// gathered as `candidates` asks, the decision over them answers, and the
-  /// verdict does not run.
-  Decision decision = Decision::candidates;
 };
-
-/// Whether a match gathers the candidates: asked for, or they decide.
-inline bool gathersCandidates(const MatchParams& params) {
-  return params.candidates || params.decision == Decision::candidates;
-}
 
 /// Called with (stage name, done, total) as work advances; may be empty.
 using Progress = std::function<void(const char*, size_t, size_t)>;

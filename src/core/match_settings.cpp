@@ -41,10 +41,10 @@ std::vector<MatchSetting> declare() {
       [](M& m) { return &m.consensus_translation_cells; });
   addDegrees({"consensus_yaw_deg", K::Number, "degrees", 0.1, 90, "yaw tolerance of that agreement"},
              &M::consensus_yaw);
-  add({"min_support", K::Integer, "slice pairs", 1, 1000, "fewer agreeing slice pairs: no reliable match"},
+  add({"min_support", K::Integer, "slices", 1, 1000,
+       "descriptive slices each map needs for the features to propose a pose; slices a dense search's best pose must "
+       "hold over"},
       [](M& m) { return &m.min_support; });
-  add({"min_inliers", K::Integer, "", 2, 100000, "fewer inlier correspondences: no reliable match"},
-      [](M& m) { return &m.min_inliers; });
   add({"threads", K::Integer, "", 0, 1024, "threads one match uses; 0 = every core"}, [](M& m) { return &m.threads; });
   addDegrees({"max_tilt_deg", K::Number, "degrees", 0, 90,
               "a map leaning more than this from gravity is levelled or refused (docs/algorithm.md, \"Gravity "

@@ -53,11 +53,10 @@ Pose4 fourDofAbout(const Eigen::Matrix4d& T, const Eigen::Vector3d& c) {
   return p;
 }
 
-/// The tomographic match of two maps' feature stacks: its figures into `r`,
-/// what the verdict weighs of them into `e`.
-void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const MapFeatures& source,
+/// The tomographic match of two maps' feature stacks: its figures and its
+/// answer into `r`, what else it proposes into `e`.
+void matchSlices(MatchResult& r, FeatureProposals& e, const MapFeatures& target, const MapFeatures& source,
                  const MatchParams& params, const Progress& progress, PairCache* cache) {
-  FeatureEvidence& e = ev.features;
   FeatureFindings& f = r.features;
   const size_t nt = target.slices.size(), ns = source.slices.size();
   if (nt < static_cast<size_t>(params.min_support) || ns < static_cast<size_t>(params.min_support)) {
@@ -81,47 +80,37 @@ void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const 
     e.missing = "no slice pair produced an estimate";
     return;
   }
-  OffsetScore best = *choice.best;
+  // The winner, a copy of the right pose where a building's rooms repeat
+  // along it, is one proposal among its rivals (distinctAnswers): the
+  // decision weighs them all on the occupancy alike.
+  const OffsetScore& best = *choice.best;
   f.runner_up_support = choice.runner_up_support;
   f.runner_up_offset = choice.runner_up_offset;
-  // A weak winner's rivals are weighed on the occupancy: the answer whose
-  // landing holds and clearly outscores the rest, against the answers that
-  // hold too. The full-size building at g 0.2 (seed 3): the winner, a copy
-  // one room along (10 slice pairs), and the right pose at the same offset
-  // (10 too).
-  if (weakWinner(static_cast<int>(best.consensus.support()) - f.runner_up_support, params))
-    if (const auto landed = chooseByLanding(pairs, target, source, params)) {
-      if (!sameAnswer(landed->answer, best, params, source.centre())) best = landed->answer;
-      f.runner_up_support = landed->rival_support;
-      f.runner_up_offset = landed->rival_offset;
-    }
   f.support = static_cast<int>(best.consensus.support());
   f.height_offset = best.offset;
-  if (gathersCandidates(params)) {
-    // Every slice pair's estimate with its source slice and height offset, for the candidates' votes.
-    struct Vote {
-      int source_slice, offset;
-      Rigid2D T;
-    };
-    std::vector<Vote> estimates;
-    for (size_t k = 0; k < pairs.estimates.size(); ++k)
-      if (pairs.matched[k] && pairs.estimates[k].ok)
-        estimates.push_back({source.slices[k % ns].index, target.slices[k / ns].index - source.slices[k % ns].index,
-                             pairs.estimates[k].T});
-    ev.feature_votes = [estimates = std::move(estimates), same = consensusParams(params, target.grid),
-                        centre = source.centre(), n = source.occupancy.size()](const Rigid2D& T, int offset) {
-      std::vector<int> by_slice(static_cast<size_t>(n), 0);
-      for (const Vote& v : estimates)
-        if (v.source_slice < n && onePlace(v.T, v.offset, T, offset, same, centre))
-          ++by_slice[static_cast<size_t>(v.source_slice)];
-      return by_slice;
-    };
-    int rank = 0;
-    for (const OffsetScore& a : distinctAnswers(pairs, target, source, params))
-      if (!sameAnswer(a, best, params, source.centre()))
-        ev.feature_rivals.push_back({Candidate::From::feature_rival, ++rank, static_cast<int>(a.consensus.support()),
-                                     a.consensus.mean, a.offset});
-  }
+  // Every slice pair's estimate with its source slice and height offset, for the candidates' votes.
+  struct Vote {
+    int source_slice, offset;
+    Rigid2D T;
+  };
+  std::vector<Vote> estimates;
+  for (size_t k = 0; k < pairs.estimates.size(); ++k)
+    if (pairs.matched[k] && pairs.estimates[k].ok)
+      estimates.push_back({source.slices[k % ns].index, target.slices[k / ns].index - source.slices[k % ns].index,
+                           pairs.estimates[k].T});
+  e.votes = [estimates = std::move(estimates), same = consensusParams(params, target.grid), centre = source.centre(),
+             n = source.occupancy.size()](const Rigid2D& T, int offset) {
+    std::vector<int> by_slice(static_cast<size_t>(n), 0);
+    for (const Vote& v : estimates)
+      if (v.source_slice < n && onePlace(v.T, v.offset, T, offset, same, centre))
+        ++by_slice[static_cast<size_t>(v.source_slice)];
+    return by_slice;
+  };
+  int rank = 0;
+  for (const OffsetScore& a : distinctAnswers(pairs, target, source, params))
+    if (!sameAnswer(a, best, params, source.centre()))
+      e.rivals.push_back({Candidate::From::feature_rival, ++rank, static_cast<int>(a.consensus.support()),
+                          a.consensus.mean, a.offset});
   for (size_t k : best.consensus.supporters)
     f.supporters.push_back({target.slices[k / ns].index, source.slices[k % ns].index, pairs.estimates[k].inliers});
   std::stable_sort(f.supporters.begin(), f.supporters.end(),
@@ -131,15 +120,11 @@ void matchSlices(MatchResult& r, Evidence& ev, const MapFeatures& target, const 
   const Refined refined = refineOffset(pairs, target, source, best.offset, best.consensus.mean, params);
   r.timings.refinement = secondsSince(t0);
 
-  // The features' answer is the answer until the verdict says otherwise (dense_opinion.hpp).
+  // The features' answer, proposed to the decision (dense_opinion.hpp).
   r.T_target_source = poseAt(refined.T, best.offset, target, source);
   r.height_offset = best.offset;
   f.inliers = refined.inliers.size();
   f.inlier_spread = inlierSpread(refined);
-  e.support = f.support;
-  e.runner_up_support = f.runner_up_support;
-  e.runner_up_gap = std::abs(f.runner_up_offset - f.height_offset);
-  e.inliers = f.inliers;
 }
 
 }  // namespace
@@ -219,19 +204,17 @@ MatchResult resultFor(const MapFeatures& target, const MapFeatures& source) {
 MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, const MatchParams& params,
                           const Progress& progress, PairCache* cache) {
   MatchResult r = resultFor(target, source);
-  r.decision = params.decision;
-  Evidence e;
-  e.grid = target.grid;
   auto tilted = tiltRefusal(target, "target", params);
   if (!tilted) tilted = tiltRefusal(source, "source", params);
   if (tilted) {
-    e.tilted = std::move(*tilted);
-  } else {
-    if (std::abs(target.grid - source.grid) > 1e-9)
-      throw InputError("feature sets use different grid sizes (" + std::to_string(target.grid) + " and " +
-                       std::to_string(source.grid) + " m)");
-    matchSlices(r, e, target, source, params, progress, cache);
+    r.reason = std::move(*tilted);
+    return r;
   }
+  if (std::abs(target.grid - source.grid) > 1e-9)
+    throw InputError("feature sets use different grid sizes (" + std::to_string(target.grid) + " and " +
+                     std::to_string(source.grid) + " m)");
+  FeatureProposals e;
+  matchSlices(r, e, target, source, params, progress, cache);
   settleMatch(r, e, target, source, params);
   Eigen::Matrix4d answer = r.T_target_source.matrix();  // between the levelled frames
   SixDofFinishParams finish;
@@ -247,23 +230,8 @@ MatchResult matchFeatures(const MapFeatures& target, const MapFeatures& source, 
       r.T_target_source = fourDofAbout(answer, occupancyCentre(source.occupancy));
     }
   }
-  const bool candidate_answer = r.candidate_verdict && r.candidate_verdict->answer >= 0;
-  if (candidate_answer && params.decision == Decision::verdict && params.finish) {
-    // The decision's answer beside the verdict, finished as the verdict's is
-    // (its time counted with the finish's).
-    const auto t0 = Clock::now();
-    const Candidate& c = r.candidates[static_cast<size_t>(r.candidate_verdict->answer)];
-    const SixDofFinish f = finishSixDof(target.occupancy, source.occupancy,
-                                        poseAt(c.landed.transform, c.landed.offset, target, source).matrix(), finish);
-    if (f.held)
-      r.candidate_verdict->finished = betweenOwnFrames(f.T_target_source, target.slicedUp(), source.slicedUp());
-    r.timings.finish += secondsSince(t0);
-  }
   if (target.leveled || source.leveled || (r.finish && r.finish->held))
     r.T_target_source_6dof = betweenOwnFrames(answer, target.slicedUp(), source.slicedUp());
-  // Where the decision answered, its finish is the answer's.
-  if (candidate_answer && params.decision == Decision::candidates && r.finish && r.finish->held)
-    r.candidate_verdict->finished = r.T_target_source_6dof;
   return r;
 }
 

@@ -35,7 +35,7 @@ struct SupportingPair {
   uint32_t inliers = 0;                    ///< RANSAC inliers of that pair's own estimate
 };
 
-/// What the tomographic match found, whatever the verdict made of it: each
+/// What the tomographic match found, whatever the decision made of it: each
 /// field means the same whichever search answered.
 struct FeatureFindings {
   int support = 0;                         ///< agreeing slice pairs behind the features' answer; 0: they had none
@@ -59,7 +59,7 @@ struct DenseFindings {
   double pooled_lead = 0;   ///< the search on occupancy pooled to twice the cell
   /// Where the search whose pose would answer, asked again with the maps'
   /// roles swapped, put the source's frame origin, apart from that pose [m]
-  /// (verdict.hpp, SecondLook); unset where it was not asked or found none.
+  /// (candidate_decision.hpp, SecondLook); unset where it was not asked or found none.
   std::optional<double> second_look_apart;
 };
 
@@ -84,13 +84,11 @@ struct MatchResult {
   /// The search whose pose is the answer (reliable only): the features
   /// (Candidate::From::features) or one of the dense searches.
   Candidate::From answered_by = Candidate::From::features;
-  /// Winning target slice index - source slice index of the answer (small
-  /// maps: where the occupancy meets best, dense_opinion.hpp).
+  /// Target slice index - source slice index of the answer.
   int height_offset = 0;
-  /// How clearly the evidence singles out the answer: its lead over the best
-  /// answer elsewhere, in standard deviations of a difference of two counts
-  /// (verdict.hpp, answerLead), the strongest of the searches that found it.
-  /// The fleet's pose graph weighs the pair by it. 0 when not reliable.
+  /// How clearly the evidence singles out the answer: the decision's lead
+  /// (CandidateVerdict::lead_sigma) in normal sigmas. The fleet's pose graph
+  /// weighs the pair by it. 0 when not reliable.
   double lead_sigma = 0;
   double target_tilt = 0, source_tilt = 0;  ///< as measured before any levelling [rad]; -1 = not measurable
 
@@ -102,23 +100,20 @@ struct MatchResult {
   int target_slices = 0, source_slices = 0;
   size_t target_features = 0, source_features = 0;
   StageTimings timings;
-  /// What answered (MatchParams::decision).
-  Decision decision = Decision::candidates;
-  /// Where the match gathers candidates (gathersCandidates): every candidate
-  /// pose the searches proposed, refined and landed (candidates.hpp).
+  /// Every candidate pose the searches proposed, refined and landed
+  /// (candidates.hpp); empty where the maps were refused before any search.
   std::vector<Candidate> candidates;
-  /// Where the match gathers candidates: the decision over them
-  /// (candidate_decision.hpp); the answer with Decision::candidates, beside
-  /// the verdict otherwise (it then changes no answer).
+  /// The decision over them (candidate_decision.hpp), which is the answer;
+  /// unset where a map was refused before any search (too tilted).
   std::optional<CandidateVerdict> candidate_verdict;
 };
 
 /// Finds T_target_source from two feature stacks of the same grid size: slice
 /// pairs estimated (slice_pairs.hpp), height offsets scored and the best picked
-/// (height_offsets.hpp; a weak winner weighed against its rivals,
-/// rival_answers.hpp), the winner refined (refine.hpp), the answer judged by
-/// the verdict (verdict.hpp), which may ask for the dense search of small maps
-/// (dense_opinion.hpp).
+/// (height_offsets.hpp) with their rivals (rival_answers.hpp), the winner
+/// refined (refine.hpp); with the dense searches' poses (small maps), every
+/// pose proposed is a candidate, and one decision over them answers
+/// (dense_opinion.hpp, candidate_decision.hpp).
 /// With a `cache` (pair_cache.hpp), the slice pairs it remembers from the
 /// last match of these two maps are recalled, not matched again, and it then
 /// remembers this match's: the answer is the same either way.

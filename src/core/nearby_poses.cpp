@@ -58,24 +58,6 @@ DensePose climb(const PoseLander& land, const SliceGrid& source, double cell, co
 
 }  // namespace
 
-DensePose bestAround(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset, int inner_cells,
-                     int outer_cells, const DenseSearchParams& params) {
-  std::vector<std::pair<Rigid2D, int>> around;
-  for (int dy = -outer_cells; dy <= outer_cells; ++dy)
-    for (int dx = -outer_cells; dx <= outer_cells; ++dx) {
-      const int r2 = dx * dx + dy * dy;
-      if (r2 <= inner_cells * inner_cells || r2 > outer_cells * outer_cells) continue;
-      Rigid2D shifted = T;
-      shifted.t += target.grid.cell * Eigen::Vector2d(dx, dy);
-      for (int o = offset - 1; o <= offset + 1; ++o) around.emplace_back(shifted, o);
-    }
-  const PoseLander land(target, source, params);
-  const std::vector<double> scores = land.scores(around);
-  if (scores.empty()) return DensePose{T, offset, 0};
-  const auto& [top, top_offset] = around[best(scores)];
-  return landPose(land, top, top_offset);
-}
-
 DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                  const DenseSearchParams& params) {
   return uphill(PoseLander(target, source, params), OccupancyRefiner(target, source), T, offset, params.threads);

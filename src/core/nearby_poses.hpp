@@ -1,20 +1,10 @@
 #pragma once
-// The poses near a pose on the maps' occupancy: how well the occupancy pins it
-// down (the best of the poses around it), and the pose uphill of it.
+// The pose uphill of a pose on the maps' occupancy: how each candidate is
+// refined before it is judged (candidates.hpp).
 #include "dense_refine.hpp"
 #include "dense_search.hpp"
 
 namespace tomomap {
-
-/// The best-scoring pose among `T` shifted by every whole grid cell more than
-/// `inner_cells` and at most `outer_cells` away, at T's yaw and within a slice
-/// of its height offset (a feature answer's height is a slice or two off,
-/// height_offsets.hpp), each judged as the dense search judges its poses (PoseLander). A pose whose
-/// neighbourhood holds one that lands as much lies on a ridge of the
-/// occupancy (a street's facades, two parallel walls) that the coarse raster
-/// of a dense search cannot resolve.
-DensePose bestAround(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset, int inner_cells,
-                     int outer_cells, const DenseSearchParams& params = {});
 
 /// The pose uphill of (T, offset): it climbs, one step at a time while a step
 /// lands more telling cells (PoseLander::scores): a grid cell in x or y, the yaw that

@@ -4,7 +4,6 @@
 
 #include "height_offsets.hpp"
 #include "offset_votes.hpp"
-#include "verdict.hpp"
 
 namespace tomomap {
 namespace {
@@ -30,14 +29,22 @@ constexpr size_t kSamplesPerOffset = 8;
 /// An offset is matched in full once its sampled support, scaled to its whole
 /// diagonal, reaches this share of the best full support so far: a sample of
 /// 8 pairs misjudges an offset's support by up to about half (synth street
-/// and building, demo-room), and an answer with 1 / 1.25 of the winner's
-/// support already makes the match ambiguous (verdict.hpp, DecisionBars::clear_ahead).
+/// and building, demo-room), and a rival with 0.8 of the winner's support
+/// is one to propose (rival_answers.hpp).
 constexpr double kRivalShare = 0.5;
 
 /// A winner under this many times min_support is checked against every pair:
 /// a rival to it (below) needs at most min_support agreeing pairs, too few for
 /// a sample of eight to tell from none.
 constexpr int kEveryPairBelow = 2;
+
+/// A winner with fewer than this many times min_support slice pairs is weak:
+/// its rivals are followed by an absolute margin (another answer within
+/// min_support pairs of it) rather than by a share of its support. On small
+/// rooms a wrong transform, repeated over a few similar slices, won 3-5 to
+/// 2-4 against another wrong one; rooms came out wrong at 7 slice pairs
+/// against 3 and at 15 against 5.
+constexpr int kStrongWinner = 5;
 
 /// The slice pairs on each height offset's diagonal (target slice index -
 /// source slice index), as table indices by increasing target slice.
@@ -96,8 +103,8 @@ std::vector<size_t> nextPairs(const SlicePairTable& table, const Diagonals& diag
   }
   // The support a rival is judged against: the winner's, or for a weak winner
   // the least that brings another answer within min_support pairs of it
-  // (ambiguous, verdict.cpp), an absolute margin the winner's share misses.
-  const int judged = weakWinner(best, params) ? best - params.min_support + 1 : best;
+  // (kStrongWinner), an absolute margin the winner's share misses.
+  const int judged = best < kStrongWinner * params.min_support ? best - params.min_support + 1 : best;
   addAround(choice.best->offset, diagonals, todo);
   if (choice.runner_up_support > 0) addAround(choice.runner_up_offset, diagonals, todo);
   for (const OffsetScore& s : scores) {

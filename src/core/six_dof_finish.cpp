@@ -249,7 +249,8 @@ Sweep sweep(Target& t, const std::vector<Eigen::Vector3d>& source, const Eigen::
   const double kernel2 = kernel * kernel;
   std::vector<int64_t> nearest(source.size());
 #pragma omp parallel for schedule(static) num_threads(threads)
-  for (size_t i = 0; i < source.size(); ++i) nearest[i] = nearestCell(t, latticeOf(t.grid, R * source[i] + shift), radius);
+  for (size_t i = 0; i < source.size(); ++i)
+    nearest[i] = nearestCell(t, latticeOf(t.grid, R * source[i] + shift), radius);
   fitPlanes(t, nearest, threads);
   std::vector<Sweep> chunks(kChunks);
   const size_t per_chunk = (source.size() + kChunks - 1) / kChunks;
@@ -434,7 +435,7 @@ SixDofFinish finishSixDof(const SliceStack& target, const SliceStack& source, co
   // fewer on the target's surfaces. That share is not a bar of its own: at
   // the right pose real SLAM maps show 0.34-0.52 (trees, people, what one
   // robot saw from a side the other did not), generated rooms 0.93; the
-  // verdict judged the pose, the finish only sharpens it.
+  // decision judged the pose, the finish only sharpens it.
   if (result.seen_found_after < result.seen_found_before - params.seen_found_noise) {
     result.why_not = "the fit got worse: " + fixed(100 * result.seen_found_before, 1) + " -> " +
                      fixed(100 * result.seen_found_after, 1) +

@@ -83,18 +83,14 @@ struct RoomMatch {
   bool answeredWrong(double grid) const { return result.reliable && !right(grid); }
 };
 
-/// The tests of SmallRooms and SmallMaps below keep the cases that shaped
-/// the verdict's rules, and match with it (`decision`) while it is kept
-/// beside the decision that replaced it; the matrix gates the decision.
-RoomMatch matchWorld(WorldType type, uint64_t seed, const char* noise, double grid,
-                     Decision decision = Decision::verdict) {
+/// One pair of a generated world of `type`, matched at `grid`.
+RoomMatch matchWorld(WorldType type, uint64_t seed, const char* noise, double grid) {
   SceneParams sp;
   sp.type = type;
   sp.seed = seed;
   const auto maps = scanScene(makeScene(sp), noiseLevel(noise), seed);
   MatchParams mp;
   mp.grid = grid;
-  mp.decision = decision;
   RoomMatch m;
   m.result = matchMaps(maps[0].points, maps[1].points, mp);
   m.error = poseError(m.result.T_target_source, Pose4::fromMatrix(maps[0].pose * maps[1].pose.inverse()));
@@ -102,8 +98,8 @@ RoomMatch matchWorld(WorldType type, uint64_t seed, const char* noise, double gr
 }
 
 /// A room pair of `synth -w room`.
-RoomMatch matchRoom(uint64_t seed, const char* noise, double grid, Decision decision = Decision::verdict) {
-  return matchWorld(WorldType::Room, seed, noise, grid, decision);
+RoomMatch matchRoom(uint64_t seed, const char* noise, double grid) {
+  return matchWorld(WorldType::Room, seed, noise, grid);
 }
 
 std::string wrongAnswer(const RoomMatch& m) {
@@ -182,12 +178,9 @@ TEST(SmallRooms, EmptySpaceTheOtherMapSawTellsARoomFromItsHalfTurn) {
 // decision over the candidates would corroborate it (a dense search's best
 // pose, a feature estimate), but not a pose the empty space contradicts so.
 TEST(SmallRooms, APoseThatContradictsWhatTheOtherMapSawEmptyDoesNotAnswer) {
-  for (const Decision decision : kDecisions) {
-    const RoomMatch m = matchRoom(208, "high", 0.1, decision);
-    EXPECT_FALSE(m.result.reliable) << decisionName(decision) << ": " << wrongAnswer(m);
-    EXPECT_NE(m.result.reason.find("in space the other map saw empty"), std::string::npos)
-        << decisionName(decision) << ": " << m.result.reason;
-  }
+  const RoomMatch m = matchRoom(208, "high", 0.1);
+  EXPECT_FALSE(m.result.reliable) << wrongAnswer(m);
+  EXPECT_NE(m.result.reason.find("in space the other map saw empty"), std::string::npos) << m.result.reason;
 }
 
 // A noise-free room at g 0.05 (seed 8) came out of the features reliable and

@@ -27,7 +27,15 @@ Candidate landing(double x, double y, double yaw, int n, const std::vector<uint3
   return c;
 }
 
-MatchParams atTenCentimetres() { return MatchParams{}; }
+/// The decision on `candidates` and `searches`, for maps of `grid` whose
+/// source raster is centred at the origin.
+CandidateVerdict decide(std::vector<Candidate> candidates, std::vector<SearchLead> searches, double grid = 0.1) {
+  DecisionEvidence e;
+  e.candidates = std::move(candidates);
+  e.searches = std::move(searches);
+  e.grid = grid;
+  return decideOnCandidates(e, MatchParams{});
+}
 
 }  // namespace
 
@@ -77,21 +85,19 @@ TEST(CandidateDecision, AVotesLeadCountsByItsSlicesNotByHowAlikeTheyAre) {
 
   // A LiDAR crop: the most voted-for pose has one estimate on each of two
   // source slices, the pose elsewhere none, and the occupancy tells neither.
-  const MatchParams p = atTenCentimetres();
   Candidate voted = landing(0, 0, 0, 2, {40}), other = landing(20, 0, 2.0, 2, {40});
   voted.feature_votes = {1, 1};
   other.feature_votes = {0, 0};
-  const CandidateVerdict v = decideOnCandidates({voted, other}, p, 0.1, Eigen::Vector2d::Zero(), {});
+  const CandidateVerdict v = decide({voted, other}, {}, 0.1);
   EXPECT_EQ(v.answer, -1) << v.reason;
   EXPECT_NE(v.reason.find("by 1.4 sigma over 2 source slices"), std::string::npos) << v.reason;
 }
 
 TEST(CandidateDecision, TheBestAnswersWhereItLeadsEveryPlaceElsewhereBeyondChance) {
-  const MatchParams p = atTenCentimetres();
   std::vector<Candidate> c{landing(0, 0, 0, 20, {60, 70, 65}), landing(5, 0, 0, 20, {30, 20, 25}),
                            // within one tolerance (5 cells, 0.5 m) of the best: the same place, not a rival
                            landing(0.3, 0, 0, 20, {58, 71, 66})};
-  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {});
+  const CandidateVerdict v = decide(c, {}, 0.1);
   ASSERT_EQ(v.answer, 0) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
   EXPECT_GE(v.lead_sigma, kBars.significant);
@@ -99,20 +105,18 @@ TEST(CandidateDecision, TheBestAnswersWhereItLeadsEveryPlaceElsewhereBeyondChanc
 }
 
 TEST(CandidateDecision, TwoPlacesThatLandAlikeAreNoAnswer) {
-  const MatchParams p = atTenCentimetres();
   std::vector<Candidate> c{landing(0, 0, 0, 20, {60, 50, 70}), landing(0, 0, 3.1, 20, {55, 65, 58})};
-  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {});
+  const CandidateVerdict v = decide(c, {}, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_NE(v.reason.find("sigma over 20 slices (need 3)"), std::string::npos) << v.reason;
   // One candidate alone has nothing to be clear of.
-  const CandidateVerdict alone = decideOnCandidates({c[0]}, p, 0.1, Eigen::Vector2d::Zero(), {});
+  const CandidateVerdict alone = decide({c[0]}, {}, 0.1);
   EXPECT_EQ(alone.answer, -1);
   EXPECT_NE(alone.reason.find("no candidate elsewhere"), std::string::npos) << alone.reason;
-  EXPECT_EQ(decideOnCandidates({}, p, 0.1, Eigen::Vector2d::Zero(), {}).answer, -1);
+  EXPECT_EQ(decide({}, {}, 0.1).answer, -1);
 }
 
 TEST(CandidateDecision, WhereTheOccupancyDoesNotTellTheFeaturesVotesDoUnlessItTellsAgainstThem) {
-  const MatchParams p = atTenCentimetres();
   // A street: two poses 3 m apart along the facades land alike; the slice
   // pairs agree with the second on every slice.
   Candidate along = landing(3, 0, 0, 20, {60, 50, 70}), right = landing(0, 0, 0, 20, {55, 65, 58});
@@ -122,13 +126,13 @@ TEST(CandidateDecision, WhereTheOccupancyDoesNotTellTheFeaturesVotesDoUnlessItTe
     right.feature_votes[k] = 3 + static_cast<int>(k % 2);
     along.feature_votes[k] = k % 3 == 0 ? 1 : 0;
   }
-  CandidateVerdict v = decideOnCandidates({along, right}, p, 0.1, Eigen::Vector2d::Zero(), {});
+  CandidateVerdict v = decide({along, right}, {}, 0.1);
   ASSERT_EQ(v.answer, 1) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::feature_votes);
   EXPECT_GE(v.lead_sigma, kBars.significant);
   // A third pose elsewhere that lands far more, slice by slice, tells against them.
   const Candidate clear = landing(-6, 2, 1.0, 20, {95, 90, 97});
-  v = decideOnCandidates({along, right, clear}, p, 0.1, Eigen::Vector2d::Zero(), {});
+  v = decide({along, right, clear}, {}, 0.1);
   EXPECT_EQ(v.answer, 2) << "the occupancy's clear best answers first: " << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
 }
@@ -137,19 +141,18 @@ TEST(CandidateDecision, WhereTheOccupancyDoesNotTellTheFeaturesVotesDoUnlessItTe
 // as features), the features' votes alone decide, and a candidate with no
 // rival elsewhere leads a place with no votes.
 TEST(CandidateDecision, WhereNoCandidateLandsTheVotesAloneDecide) {
-  const MatchParams p = atTenCentimetres();
   Candidate right = landing(0, 0, 0, 0, {0}), other = landing(4, 1, 0.5, 0, {0});
   right.feature_votes.assign(12, 2);
   other.feature_votes.assign(12, 0);
   other.feature_votes[3] = 1;
-  CandidateVerdict v = decideOnCandidates({other, right}, p, 0.1, Eigen::Vector2d::Zero(), {});
+  CandidateVerdict v = decide({other, right}, {}, 0.1);
   ASSERT_EQ(v.answer, 1) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::feature_votes);
-  v = decideOnCandidates({right}, p, 0.1, Eigen::Vector2d::Zero(), {});
+  v = decide({right}, {}, 0.1);
   EXPECT_EQ(v.answer, 0) << "alone, against no votes: " << v.reason;
   // Two source slices' votes are no lead beyond chance.
   right.feature_votes.assign(2, 5);
-  v = decideOnCandidates({right}, p, 0.1, Eigen::Vector2d::Zero(), {});
+  v = decide({right}, {}, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_NE(v.reason.find("leads no votes elsewhere (no candidate is) by 1.4 sigma over 2 source slices"),
             std::string::npos)
@@ -160,7 +163,6 @@ TEST(CandidateDecision, WhereNoCandidateLandsTheVotesAloneDecide) {
 // reads empty space but not a pose a cell or two off; the pose answered is
 // the one at that place that lands the most on the maps' own cells.
 TEST(CandidateDecision, AtItsPlaceThePoseAnsweredLandsTheMostOnTheMapsOwnCells) {
-  const MatchParams p = atTenCentimetres();
   const auto pooledAs = [](Candidate fine, const Candidate& pooled) {
     fine.pooled_slices = pooled.slices;
     return fine;
@@ -169,20 +171,19 @@ TEST(CandidateDecision, AtItsPlaceThePoseAnsweredLandsTheMostOnTheMapsOwnCells) 
                            pooledAs(landing(0.1, 0, 0, 40, {40, 45}), landing(0.1, 0, 0, 20, {70, 75})),
                            pooledAs(landing(0, 0, 0, 40, {60, 65}), landing(0, 0, 0, 20, {68, 74})),  // the same place
                            pooledAs(landing(5, 0, 0, 40, {20, 25}), landing(5, 0, 0, 20, {30, 35}))};
-  const CandidateVerdict v = decideOnCandidates(c, p, 0.05, Eigen::Vector2d::Zero(), {});
+  const CandidateVerdict v = decide(c, {}, 0.05);
   ASSERT_EQ(v.answer, 1) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
   EXPECT_EQ(v.slices, 20) << "the place's lead, on the pooled slices";
   // Unpooled (0.1 m and coarser) the best answers as it lands.
   for (Candidate& k : c) k.slices = k.pooled_slices, k.pooled_slices.clear();
-  EXPECT_EQ(decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {}).answer, 0);
+  EXPECT_EQ(decide(c, {}, 0.1).answer, 0);
 }
 
 TEST(CandidateDecision, EmptySpaceTheOtherMapSawCountsAgainstAPose) {
-  const MatchParams p = atTenCentimetres();
   // The half-turned room lands more cells but twice as many of its cells in space the target saw empty.
   std::vector<Candidate> c{landing(0, 0, 3.1, 20, {80, 85, 82}, 100, 30), landing(0, 0, 0, 20, {60, 62, 61}, 100, 0)};
-  const CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {});
+  const CandidateVerdict v = decide(c, {}, 0.1);
   EXPECT_EQ(v.answer, 1) << v.reason;
 }
 
@@ -204,7 +205,6 @@ SearchLead searchLead(Candidate::From from, double x, double y, double yaw, size
 }  // namespace
 
 TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatureEstimateFindItToo) {
-  const MatchParams p = atTenCentimetres();
   // An RGB-D crop: the right pose and a copy of it 0.6 m along a wall land
   // almost alike over few slices, not clear of each other.
   Candidate right = landing(0, 0, 0, 6, {62, 55, 70}), along = landing(0.6, 0, 0, 6, {60, 56, 66});
@@ -213,7 +213,7 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   right.feature_votes = {0, 1, 0};
   // The wide search's own best pose, 1.5x its next: beyond chance (6.3 sigma).
   const std::vector<SearchLead> wide{searchLead(Candidate::From::search_wide, 0, 0, 0, 600, 400)};
-  CandidateVerdict v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
+  CandidateVerdict v = decide({right, along}, wide, 0.1);
   ASSERT_EQ(v.answer, 0) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::corroborated);
   EXPECT_LT(v.lead_sigma, kBars.significant) << "the occupancy alone does not tell them apart";
@@ -221,7 +221,7 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   // The search's best pose within chance of its next (1.04x, 0.7 sigma) ranks nothing.
   std::vector<SearchLead> close = wide;
   close[0].found.next_score = 600 / 1.04;
-  v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero(), close);
+  v = decide({right, along}, close, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_NE(v.reason.find("search_wide's best pose is at its place but within chance of its next (1.04x, 0.7 sigma)"),
             std::string::npos)
@@ -229,13 +229,13 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   // Another search clear of its next, whose best pose lies elsewhere, does not stand in for it.
   std::vector<SearchLead> elsewhere = close;
   elsewhere.push_back(searchLead(Candidate::From::search_pooled, 0.6, 0, 0, 900, 300));
-  v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero(), elsewhere);
+  v = decide({right, along}, elsewhere, 0.1);
   EXPECT_EQ(v.answer, -1) << "search_pooled's best pose is the copy along the wall";
   // Beyond chance by however small a ratio: 6,000 cells against 5,400 is 1.11x, 5.6 sigma.
   std::vector<SearchLead> many = wide;
   many[0].found.best.telling_inliers = 6000;
   many[0].found.next_score = 5400;
-  v = decideOnCandidates({right, along}, p, 0.1, Eigen::Vector2d::Zero(), many);
+  v = decide({right, along}, many, 0.1);
   EXPECT_EQ(v.answer, 0) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::corroborated);
 
@@ -244,17 +244,17 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   // occupancy (both ways, as the climb lands it) against at most 20 %.
   Candidate contradicted = right;
   contradicted.landed.telling_inliers = 1000, contradicted.landed.contradicted = 240;
-  v = decideOnCandidates({contradicted, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
+  v = decide({contradicted, along}, wide, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_NE(v.reason.find("it lands 24 % as many telling cells in space the other map saw empty"), std::string::npos)
       << v.reason;
   contradicted.landed.contradicted = 200;
-  EXPECT_EQ(decideOnCandidates({contradicted, along}, p, 0.1, Eigen::Vector2d::Zero(), wide).answer, 0);
+  EXPECT_EQ(decide({contradicted, along}, wide, 0.1).answer, 0);
 
   // No slice-pair estimate there: the occupancy's word alone, which is not clear.
   Candidate unvoted = right;
   unvoted.feature_votes.clear();
-  v = decideOnCandidates({unvoted, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
+  v = decide({unvoted, along}, wide, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_NE(v.reason.find("no slice-pair estimate of the features agrees"), std::string::npos) << v.reason;
 
@@ -263,7 +263,7 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   Candidate runner_up = right;
   runner_up.rank = 1;
   along.rank = 0;
-  v = decideOnCandidates({runner_up, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
+  v = decide({runner_up, along}, wide, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_NE(v.reason.find("no dense search's best pose is at its place"), std::string::npos) << v.reason;
 
@@ -272,7 +272,7 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
   from_features.from = Candidate::From::features;
   along.rank = 1;
   along.from = Candidate::From::feature_rival;
-  v = decideOnCandidates({from_features, along}, p, 0.1, Eigen::Vector2d::Zero(), wide);
+  v = decide({from_features, along}, wide, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_NE(v.reason.find("no dense search of the occupancy"), std::string::npos) << v.reason;
 }
@@ -282,16 +282,15 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatur
 // the whole occupancy puts its own best pose at the right one, far ahead of
 // its next, and finds it again with the maps' roles swapped.
 TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereASearchsClearBestIsFoundAgainBothWays) {
-  const MatchParams p = atTenCentimetres();
   const std::vector<Candidate> c{landing(0, 0, 0, 6, {62, 55, 70}), landing(0.6, 0, 0, 6, {60, 56, 66})};
   std::vector<SearchLead> searches{searchLead(Candidate::From::search_at_grid, 0.05, 0, 0, 900, 300)};
-  CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), searches);
+  CandidateVerdict v = decide(c, searches, 0.1);
   EXPECT_EQ(v.answer, -1);
   ASSERT_TRUE(v.needs_look.has_value()) << "the look decides, so the decision asks for it: " << v.reason;
   EXPECT_EQ(*v.needs_look, Candidate::From::search_at_grid);
 
   searches[0].look = SecondLook{true, true, 0.02};
-  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), searches);
+  v = decide(c, searches, 0.1);
   ASSERT_EQ(v.answer, 0) << v.reason;
   EXPECT_EQ(v.on, CandidateVerdict::On::second_look);
   EXPECT_FALSE(v.needs_look);
@@ -299,7 +298,7 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereASearchsClearBestIsFou
 
   // Asked again the other way round, the search finds another place: no answer, and the reason says so.
   searches[0].look = SecondLook{true, false, 2.4};
-  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), searches);
+  v = decide(c, searches, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_FALSE(v.needs_look);
   EXPECT_NE(v.reason.find("search_at_grid with the maps' roles swapped found another place, 2.40 m apart"),
@@ -312,17 +311,16 @@ TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereASearchsClearBestIsFou
   pooled.pooling = 2;
   pooled.look.reset();
   searches.push_back(pooled);
-  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), searches);
+  v = decide(c, searches, 0.1);
   ASSERT_TRUE(v.needs_look.has_value()) << v.reason;
   EXPECT_EQ(*v.needs_look, Candidate::From::search_pooled);
   searches[1].look = SecondLook{false, false, 0.0};
-  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), searches);
+  v = decide(c, searches, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_NE(v.reason.find("search_pooled with the maps' roles swapped found no pose"), std::string::npos) << v.reason;
 }
 
 TEST(CandidateDecision, ASearchsBestPoseNotClearOfItsNextOrClearlyElsewhereDoesNotAnswer) {
-  const MatchParams p = atTenCentimetres();
   const std::vector<Candidate> c{landing(0, 0, 0, 6, {62, 55, 70}), landing(0.6, 0, 0, 6, {60, 56, 66})};
   SearchLead grid = searchLead(Candidate::From::search_at_grid, 0, 0, 0, 900, 300);
   grid.look = SecondLook{true, true, 0.0};
@@ -330,13 +328,13 @@ TEST(CandidateDecision, ASearchsBestPoseNotClearOfItsNextOrClearlyElsewhereDoesN
   // 1.3x ahead of its next: not clear of it, however often it is found again.
   SearchLead close = grid;
   close.found.next_score = 900 / 1.3;
-  CandidateVerdict v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {close});
+  CandidateVerdict v = decide(c, {close}, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_FALSE(v.needs_look);
   // Clear, but on fewer slices than min_support: a floor alone.
   SearchLead thin = grid;
-  thin.found.best.support = p.min_support - 1;
-  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {thin});
+  thin.found.best.support = MatchParams{}.min_support - 1;
+  v = decide(c, {thin}, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_FALSE(v.needs_look);
 
@@ -345,15 +343,15 @@ TEST(CandidateDecision, ASearchsBestPoseNotClearOfItsNextOrClearlyElsewhereDoesN
   // crop's pooled best, found again both ways, was wrong where the grid's
   // best lay elsewhere, 1.96x ahead.
   const SearchLead wide_elsewhere = searchLead(Candidate::From::search_wide, 3, 1, 1.5, 500, 200);
-  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {grid, wide_elsewhere});
+  v = decide(c, {grid, wide_elsewhere}, 0.1);
   EXPECT_EQ(v.answer, -1);
   EXPECT_NE(v.reason.find("search_wide's best pose lies elsewhere, 2.50x ahead of its next"), std::string::npos)
       << v.reason;
   const SearchLead wide_here = searchLead(Candidate::From::search_wide, 0, 0, 0, 500, 200);
-  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {wide_here});
+  v = decide(c, {wide_here}, 0.1);
   EXPECT_EQ(v.answer, -1) << "the wide search alone has no second look";
   EXPECT_FALSE(v.needs_look);
-  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {wide_here, grid});
+  v = decide(c, {wide_here, grid}, 0.1);
   EXPECT_EQ(v.answer, 0) << v.reason;
 
   // A pooled search's best pose is a whole number of pooled slices high: a
@@ -362,7 +360,7 @@ TEST(CandidateDecision, ASearchsBestPoseNotClearOfItsNextOrClearlyElsewhereDoesN
   pooled.from = Candidate::From::search_pooled;
   pooled.pooling = 2;
   pooled.found.best.offset = kSmearSlices / 2 + 1;
-  v = decideOnCandidates(c, p, 0.1, Eigen::Vector2d::Zero(), {pooled});
+  v = decide(c, {pooled}, 0.1);
   EXPECT_EQ(v.answer, 0) << v.reason;
 }
 
@@ -372,7 +370,6 @@ TEST(CandidateDecision, ASearchsBestPoseNotClearOfItsNextOrClearlyElsewhereDoesN
 // off and landed more than the wide search's best, 0.10 m off), the
 // search's pose is answered, not the one that lands the most.
 TEST(CandidateDecision, ASecondLookAnswersThePoseItFoundAgain) {
-  const MatchParams p = atTenCentimetres();
   Candidate most = landing(0.3, 0, 0, 6, {63, 54, 71}), searched = landing(0, 0, 0, 6, {62, 55, 70}),
             copy = landing(1.2, 0, 0, 6, {60, 56, 66});
   most.from = Candidate::From::search_pooled, most.rank = 1;
@@ -380,7 +377,7 @@ TEST(CandidateDecision, ASecondLookAnswersThePoseItFoundAgain) {
   copy.from = Candidate::From::search_wide;
   SearchLead grid = searchLead(Candidate::From::search_at_grid, 0, 0, 0, 900, 300);
   grid.look = SecondLook{true, true, 0.02};
-  const CandidateVerdict v = decideOnCandidates({most, searched, copy}, p, 0.1, Eigen::Vector2d::Zero(), {grid});
+  const CandidateVerdict v = decide({most, searched, copy}, {grid}, 0.1);
   ASSERT_EQ(v.on, CandidateVerdict::On::second_look) << v.reason;
   EXPECT_EQ(v.answer, 1) << "the grid's own best, as it climbed";
 }

@@ -81,7 +81,7 @@ TEST(DaemonConfig, TheMatchTableOverridesTheMatchersDefaults) {
   EXPECT_NEAR(c.match.consensus_yaw, radians(5), 1e-12);
   EXPECT_EQ(c.match.threads, 1);
   EXPECT_EQ(c.match.features.max_features, 500);
-  EXPECT_EQ(c.match.min_inliers, MatchParams{}.min_inliers) << "keys not given keep the default";
+  EXPECT_EQ(c.match.min_matches, MatchParams{}.min_matches) << "keys not given keep the default";
   EXPECT_NE(describe(c).find("match.min_support = 5"), std::string::npos) << describe(c);
 
   std::string e = errorOf(dir, base + "[match]\nmin_support = 2.5\n");

@@ -4,12 +4,12 @@
 #include <cmath>
 #include <tuple>
 
+#include "core/candidate_decision.hpp"
 #include "core/candidates.hpp"
 #include "core/dense_refine.hpp"
 #include "core/dense_search.hpp"
 #include "core/matcher.hpp"
 #include "core/nearby_poses.hpp"
-#include "core/verdict.hpp"
 #include "core/voxel_filter.hpp"
 #include "synth/synth.hpp"
 
@@ -192,36 +192,6 @@ TEST(DenseSearch, ASliceOfAPartialCropHoldsOnTheCellsThatLandWhereTheOtherMapSaw
   const DensePose apart = landPose(t, s, Rigid2D{0.0, Eigen::Vector2d(0.0, 1.5)}, offset);
   std::cout << "a pose 1.5 m off: " << apart.support_seen << "\n";
   EXPECT_LT(apart.support_seen, right.support_seen / 2) << "a pose 1.5 m off";
-}
-
-// A room pins a pose down: every pose 0.5-2 m around the right one lands far
-// fewer cells. Two long rails along a street (low, so their cells tell places
-// apart; a floor under them and a post at one end) do not: a pose moved along
-// them lands almost as much, which a coarse search cannot tell from the right
-// one (the verdict then refuses a thin feature answer there).
-TEST(DenseSearch, ThePosesAroundAPoseShowWhetherTheOccupancyPinsItDown) {
-  const SliceStack room = stackOf(roomScan());
-  const Rigid2D right;
-  DenseSearchParams two_threads;
-  two_threads.threads = 2;
-  const DensePose at_room = landPose(room, room, right, 0),
-                  near_room = bestAround(room, room, right, 0, 5, 20, two_threads);
-  EXPECT_GT(significance(at_room.score(), near_room.score()), kBars.significant);
-  const double apart = near_room.transform.t.norm();
-  EXPECT_GT(apart, 5 * kGrid);
-  EXPECT_LE(apart, 20 * kGrid + 1e-9);
-
-  Points street;
-  for (float x = 0; x < 30; x += 0.05f) {
-    for (float y = 0; y < 2; y += 0.05f) street.emplace_back(x, y, -0.1f);
-    for (float z = 0; z < 0.5f; z += 0.05f) street.emplace_back(x, 0.f, z);
-    for (float z = 1; z < 1.5f; z += 0.05f) street.emplace_back(x, 2.f, z);
-  }
-  for (float z = 0; z < 3; z += 0.05f) street.emplace_back(0.f, 1.f, z);
-  const SliceStack rails = stackOf(street);
-  const DensePose at_rails = landPose(rails, rails, right, 0), near_rails = bestAround(rails, rails, right, 0, 5, 20);
-  ASSERT_GT(at_rails.score(), 0);
-  EXPECT_LT(significance(at_rails.score(), near_rails.score()), kBars.significant);
 }
 
 // A pose a few cells and degrees off the right one, as a dense search's coarse
