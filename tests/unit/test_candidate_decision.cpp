@@ -93,105 +93,12 @@ TEST(CandidateDecision, AVotesLeadCountsByItsSlicesNotByHowAlikeTheyAre) {
   EXPECT_NE(v.reason.find("by 1.4 sigma over 2 source slices"), std::string::npos) << v.reason;
 }
 
-TEST(CandidateDecision, TheBestAnswersWhereItLeadsEveryPlaceElsewhereBeyondChance) {
-  std::vector<Candidate> c{landing(0, 0, 0, 20, {60, 70, 65}), landing(5, 0, 0, 20, {30, 20, 25}),
-                           // within one tolerance (5 cells, 0.5 m) of the best: the same place, not a rival
-                           landing(0.3, 0, 0, 20, {58, 71, 66})};
-  const CandidateVerdict v = decide(c, {}, 0.1);
-  ASSERT_EQ(v.answer, 0) << v.reason;
-  EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
-  EXPECT_GE(v.lead_sigma, kBars.significant);
-  EXPECT_EQ(v.slices, 20);
-}
-
-TEST(CandidateDecision, TwoPlacesThatLandAlikeAreNoAnswer) {
-  std::vector<Candidate> c{landing(0, 0, 0, 20, {60, 50, 70}), landing(0, 0, 3.1, 20, {55, 65, 58})};
-  const CandidateVerdict v = decide(c, {}, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("sigma over 20 slices (need 3)"), std::string::npos) << v.reason;
-  // One candidate alone has nothing to be clear of.
-  const CandidateVerdict alone = decide({c[0]}, {}, 0.1);
-  EXPECT_EQ(alone.answer, -1);
-  EXPECT_NE(alone.reason.find("no candidate elsewhere"), std::string::npos) << alone.reason;
-  EXPECT_EQ(decide({}, {}, 0.1).answer, -1);
-}
-
-TEST(CandidateDecision, WhereTheOccupancyDoesNotTellTheFeaturesVotesDoUnlessItTellsAgainstThem) {
-  // A street: two poses 3 m apart along the facades land alike; the slice
-  // pairs agree with the second on every slice.
-  Candidate along = landing(3, 0, 0, 20, {60, 50, 70}), right = landing(0, 0, 0, 20, {55, 65, 58});
-  along.feature_votes.assign(20, 0);
-  right.feature_votes.assign(20, 0);
-  for (size_t k = 0; k < 20; ++k) {
-    right.feature_votes[k] = 3 + static_cast<int>(k % 2);
-    along.feature_votes[k] = k % 3 == 0 ? 1 : 0;
-  }
-  CandidateVerdict v = decide({along, right}, {}, 0.1);
-  ASSERT_EQ(v.answer, 1) << v.reason;
-  EXPECT_EQ(v.on, CandidateVerdict::On::feature_votes);
-  EXPECT_GE(v.lead_sigma, kBars.significant);
-  // A third pose elsewhere that lands far more, slice by slice, tells against them.
-  const Candidate clear = landing(-6, 2, 1.0, 20, {95, 90, 97});
-  v = decide({along, right, clear}, {}, 0.1);
-  EXPECT_EQ(v.answer, 2) << "the occupancy's clear best answers first: " << v.reason;
-  EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
-}
-
-// Where no candidate lands a telling cell (a peer map whose slices all came
-// as features), the features' votes alone decide, and a candidate with no
-// rival elsewhere leads a place with no votes.
-TEST(CandidateDecision, WhereNoCandidateLandsTheVotesAloneDecide) {
-  Candidate right = landing(0, 0, 0, 0, {0}), other = landing(4, 1, 0.5, 0, {0});
-  right.feature_votes.assign(12, 2);
-  other.feature_votes.assign(12, 0);
-  other.feature_votes[3] = 1;
-  CandidateVerdict v = decide({other, right}, {}, 0.1);
-  ASSERT_EQ(v.answer, 1) << v.reason;
-  EXPECT_EQ(v.on, CandidateVerdict::On::feature_votes);
-  v = decide({right}, {}, 0.1);
-  EXPECT_EQ(v.answer, 0) << "alone, against no votes: " << v.reason;
-  // Two source slices' votes are no lead beyond chance.
-  right.feature_votes.assign(2, 5);
-  v = decide({right}, {}, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("leads no votes elsewhere (no candidate is) by 1.4 sigma over 2 source slices"),
-            std::string::npos)
-      << v.reason;
-}
-
-// On maps finer than 0.1 m the place is judged on pooled occupancy, which
-// reads empty space but not a pose a cell or two off; the pose answered is
-// the one at that place that lands the most on the maps' own cells.
-TEST(CandidateDecision, AtItsPlaceThePoseAnsweredLandsTheMostOnTheMapsOwnCells) {
-  const auto pooledAs = [](Candidate fine, const Candidate& pooled) {
-    fine.pooled_slices = pooled.slices;
-    return fine;
-  };
-  std::vector<Candidate> c{// lands the most pooled; two cells off, so less on its own cells
-                           pooledAs(landing(0.1, 0, 0, 40, {40, 45}), landing(0.1, 0, 0, 20, {70, 75})),
-                           pooledAs(landing(0, 0, 0, 40, {60, 65}), landing(0, 0, 0, 20, {68, 74})),  // the same place
-                           pooledAs(landing(5, 0, 0, 40, {20, 25}), landing(5, 0, 0, 20, {30, 35}))};
-  const CandidateVerdict v = decide(c, {}, 0.05);
-  ASSERT_EQ(v.answer, 1) << v.reason;
-  EXPECT_EQ(v.on, CandidateVerdict::On::occupancy);
-  EXPECT_EQ(v.slices, 20) << "the place's lead, on the pooled slices";
-  // Unpooled (0.1 m and coarser) the best answers as it lands.
-  for (Candidate& k : c) k.slices = k.pooled_slices, k.pooled_slices.clear();
-  EXPECT_EQ(decide(c, {}, 0.1).answer, 0);
-}
-
-TEST(CandidateDecision, EmptySpaceTheOtherMapSawCountsAgainstAPose) {
-  // The half-turned room lands more cells but twice as many of its cells in space the target saw empty.
-  std::vector<Candidate> c{landing(0, 0, 3.1, 20, {80, 85, 82}, 100, 30), landing(0, 0, 0, 20, {60, 62, 61}, 100, 0)};
-  const CandidateVerdict v = decide(c, {}, 0.1);
-  EXPECT_EQ(v.answer, 1) << v.reason;
-}
-
 namespace {
 
 /// A dense search's word on its own best pose at (x, y, yaw): `best` telling
 /// cells landed over 6 slices, its next pose `next`.
-SearchLead searchLead(Candidate::From from, double x, double y, double yaw, size_t best, double next) {
+SearchLead searchLead(Candidate::From from, double x, double y, double yaw, size_t best, double next,
+                      std::optional<SecondLook> look = {}) {
   SearchLead s;
   s.from = from;
   s.found.found = true;
@@ -199,185 +106,258 @@ SearchLead searchLead(Candidate::From from, double x, double y, double yaw, size
   s.found.best.telling_inliers = best;
   s.found.best.support = s.found.best.support_seen = 6;
   s.found.next_score = next;
+  s.look = look;
   return s;
+}
+
+/// `c` from `from`, of rank `rank`, with `votes` (by source slice).
+Candidate as(Candidate c, Candidate::From from, int rank = 0, std::vector<int> votes = {}) {
+  c.from = from;
+  c.rank = rank;
+  c.feature_votes = std::move(votes);
+  return c;
+}
+
+/// `fine` judged, as on maps finer than 0.1 m, on `pooled`'s slices.
+Candidate pooledAs(Candidate fine, const Candidate& pooled) {
+  fine.pooled_slices = pooled.slices;
+  return fine;
+}
+
+/// `c` landing `contradicted` telling cells in the target's empty space per 1,000 on its occupancy.
+Candidate contradicting(Candidate c, uint32_t contradicted) {
+  c.landed.telling_inliers = 1000, c.landed.contradicted = contradicted;
+  return c;
+}
+
+/// Votes of a street's slice pairs: 3-4 on every one of 20 source slices for
+/// the right pose, 1 on every third for a pose along the facades.
+std::vector<int> streetVotes(bool right) {
+  std::vector<int> v(20);
+  for (size_t k = 0; k < v.size(); ++k) v[k] = right ? 3 + static_cast<int>(k % 2) : (k % 3 == 0 ? 1 : 0);
+  return v;
+}
+
+using From = Candidate::From;
+using On = CandidateVerdict::On;
+
+/// One row of the decision's truth table: the evidence, and what it decides.
+struct Row {
+  const char* what;
+  std::vector<Candidate> candidates;
+  std::vector<SearchLead> searches;
+  double grid;
+  int answer;          ///< -1: no reliable match
+  On on;               ///< where it answers
+  const char* reason;  ///< a part of why not, where it does not
+  std::optional<From> needs_look = std::nullopt;
+};
+
+/// A room's right pose and a copy of it 0.6 m along a wall, landing alike over 6 slices.
+Candidate right() { return landing(0, 0, 0, 6, {62, 55, 70}); }
+Candidate along() { return landing(0.6, 0, 0, 6, {60, 56, 66}); }
+/// The wide search's own best pose at the right one, 1.5x its next (6.3 sigma).
+SearchLead wideAtRight() { return searchLead(From::search_wide, 0, 0, 0, 600, 400); }
+/// The search at the grid's, 3x its next, found again with the maps' roles swapped.
+SearchLead gridFoundAgain() {
+  return searchLead(From::search_at_grid, 0, 0, 0, 900, 300, SecondLook{true, true, 0.02});
+}
+
+std::vector<Row> truthTable() {
+  const std::vector<int> one_vote{0, 1, 0};
+  return {
+      // 3. The occupancy: the candidate that lands the most, slice by slice, beyond chance of every place elsewhere.
+      {"the best lands beyond chance more than every place elsewhere (one 0.3 m along is the same place)",
+       {landing(0, 0, 0, 20, {60, 70, 65}), landing(5, 0, 0, 20, {30, 20, 25}), landing(0.3, 0, 0, 20, {58, 71, 66})},
+       {},
+       0.1,
+       0,
+       On::occupancy,
+       ""},
+      {"two places that land alike",
+       {landing(0, 0, 0, 20, {60, 50, 70}), landing(0, 0, 3.1, 20, {55, 65, 58})},
+       {},
+       0.1,
+       -1,
+       On::occupancy,
+       "sigma over 20 slices (need 3)"},
+      {"one candidate has nothing to be clear of",
+       {landing(0, 0, 0, 20, {60, 50, 70})},
+       {},
+       0.1,
+       -1,
+       On::occupancy,
+       "no candidate elsewhere"},
+      {"a half turn lands more, but as much in space the target saw empty",
+       {landing(0, 0, 3.1, 20, {80, 85, 82}, 100, 30), landing(0, 0, 0, 20, {60, 62, 61})},
+       {},
+       0.1,
+       1,
+       On::occupancy,
+       ""},
+      {"finer than 0.1 m: the place on pooled cells, the pose at it that lands the most on its own",
+       {pooledAs(landing(0.1, 0, 0, 40, {40, 45}), landing(0.1, 0, 0, 20, {70, 75})),
+        pooledAs(landing(0, 0, 0, 40, {60, 65}), landing(0, 0, 0, 20, {68, 74})),
+        pooledAs(landing(5, 0, 0, 40, {20, 25}), landing(5, 0, 0, 20, {30, 35}))},
+       {},
+       0.05,
+       1,
+       On::occupancy,
+       ""},
+      // 3. Corroborated: a dense search's clear best pose and a feature estimate at the occupancy's best place.
+      {"corroborated",
+       {as(right(), From::search_wide, 0, one_vote), as(along(), From::search_pooled)},
+       {wideAtRight()},
+       0.1,
+       0,
+       On::corroborated,
+       ""},
+      {"the search's best within chance of its next (1.04x)",
+       {as(right(), From::search_wide, 0, one_vote), as(along(), From::search_pooled)},
+       {searchLead(From::search_wide, 0, 0, 0, 600, 600 / 1.04)},
+       0.1,
+       -1,
+       On::occupancy,
+       "search_wide's best pose is at its place but within chance of its next (1.04x, 0.7 sigma)"},
+      {"24 % of its telling cells in the target's empty space (at most 20 %)",
+       {contradicting(as(right(), From::search_wide, 0, one_vote), 240), as(along(), From::search_pooled)},
+       {wideAtRight()},
+       0.1,
+       -1,
+       On::occupancy,
+       "it lands 24 % as many telling cells in space the other map saw empty"},
+      {"no feature estimate agrees with it",
+       {as(right(), From::search_wide), as(along(), From::search_pooled)},
+       {wideAtRight()},
+       0.1,
+       -1,
+       On::occupancy,
+       "no slice-pair estimate of the features agrees with it"},
+      {"the search's own best is the copy, this its runner-up",
+       {as(right(), From::search_wide, 1, one_vote), as(along(), From::search_wide)},
+       {wideAtRight()},
+       0.1,
+       -1,
+       On::occupancy,
+       "no dense search's best pose is at its place"},
+      {"the features alone corroborate nothing",
+       {as(right(), From::features, 0, one_vote), as(along(), From::feature_rival, 1)},
+       {wideAtRight()},
+       0.1,
+       -1,
+       On::occupancy,
+       "no dense search of the occupancy"},
+      // 4. The votes: the candidate most slice-pair estimates agree with, source slice by source slice.
+      {"a street's poses along its facades land alike; the votes tell them apart",
+       {as(landing(3, 0, 0, 20, {60, 50, 70}), From::features, 0, streetVotes(false)),
+        as(landing(0, 0, 0, 20, {55, 65, 58}), From::feature_rival, 1, streetVotes(true))},
+       {},
+       0.1,
+       1,
+       On::feature_votes,
+       ""},
+      {"nothing lands (slices sent as features): the votes alone, against none elsewhere",
+       {as(landing(0, 0, 0, 0, {0}), From::features, 0, std::vector<int>(12, 2))},
+       {},
+       0.1,
+       0,
+       On::feature_votes,
+       ""},
+      {"votes on 2 source slices are no lead",
+       {as(landing(0, 0, 0, 0, {0}), From::features, 0, {5, 5})},
+       {},
+       0.1,
+       -1,
+       On::occupancy,
+       "leads no votes elsewhere (no candidate is) by 1.4 sigma over 2 source slices"},
+      // 5. The second look: a search's clear best pose at the place, found again with the maps' roles swapped.
+      {"a clear best pose at the place, not yet looked at again",
+       {right(), along()},
+       {searchLead(From::search_at_grid, 0.05, 0, 0, 900, 300)},
+       0.1,
+       -1,
+       On::occupancy,
+       "",
+       From::search_at_grid},
+      {"found again", {right(), along()}, {gridFoundAgain()}, 0.1, 0, On::second_look, ""},
+      {"found elsewhere with the maps' roles swapped",
+       {right(), along()},
+       {searchLead(From::search_at_grid, 0, 0, 0, 900, 300, SecondLook{true, false, 2.4})},
+       0.1,
+       -1,
+       On::occupancy,
+       "search_at_grid with the maps' roles swapped found another place, 2.40 m apart"},
+      {"1.3x ahead of its next is not clear",
+       {right(), along()},
+       {searchLead(From::search_at_grid, 0, 0, 0, 900, 900 / 1.3, SecondLook{true, true, 0.0})},
+       0.1,
+       -1,
+       On::occupancy,
+       ""},
+      {"clear, but over fewer slices than min_support: a floor alone",
+       {right(), along()},
+       {[] {
+         SearchLead thin = gridFoundAgain();
+         thin.found.best.support = MatchParams{}.min_support - 1;
+         return thin;
+       }()},
+       0.1,
+       -1,
+       On::occupancy,
+       ""},
+      {"another search's clear best pose elsewhere",
+       {right(), along()},
+       {gridFoundAgain(), searchLead(From::search_wide, 3, 1, 1.5, 500, 200)},
+       0.1,
+       -1,
+       On::occupancy,
+       "search_wide's best pose lies elsewhere, 2.50x ahead of its next"},
+      {"the pose found again, not another at its place that lands a little more",
+       {as(landing(0.3, 0, 0, 6, {63, 54, 71}), From::search_pooled, 1), as(right(), From::search_at_grid),
+        as(landing(1.2, 0, 0, 6, {60, 56, 66}), From::search_wide)},
+       {gridFoundAgain()},
+       0.1,
+       1,
+       On::second_look,
+       ""},
+  };
 }
 
 }  // namespace
 
-TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereADenseSearchAndAFeatureEstimateFindItToo) {
-  // An RGB-D crop: the right pose and a copy of it 0.6 m along a wall land
-  // almost alike over few slices, not clear of each other.
-  Candidate right = landing(0, 0, 0, 6, {62, 55, 70}), along = landing(0.6, 0, 0, 6, {60, 56, 66});
-  right.from = Candidate::From::search_wide;
-  along.from = Candidate::From::search_pooled;
-  right.feature_votes = {0, 1, 0};
-  // The wide search's own best pose, 1.5x its next: beyond chance (6.3 sigma).
-  const std::vector<SearchLead> wide{searchLead(Candidate::From::search_wide, 0, 0, 0, 600, 400)};
-  CandidateVerdict v = decide({right, along}, wide, 0.1);
-  ASSERT_EQ(v.answer, 0) << v.reason;
-  EXPECT_EQ(v.on, CandidateVerdict::On::corroborated);
-  EXPECT_LT(v.lead_sigma, kBars.significant) << "the occupancy alone does not tell them apart";
-
-  // The search's best pose within chance of its next (1.04x, 0.7 sigma) ranks nothing.
-  std::vector<SearchLead> close = wide;
-  close[0].found.next_score = 600 / 1.04;
-  v = decide({right, along}, close, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("search_wide's best pose is at its place but within chance of its next (1.04x, 0.7 sigma)"),
-            std::string::npos)
-      << v.reason;
-  // Another search clear of its next, whose best pose lies elsewhere, does not stand in for it.
-  std::vector<SearchLead> elsewhere = close;
-  elsewhere.push_back(searchLead(Candidate::From::search_pooled, 0.6, 0, 0, 900, 300));
-  v = decide({right, along}, elsewhere, 0.1);
-  EXPECT_EQ(v.answer, -1) << "search_pooled's best pose is the copy along the wall";
-  // Beyond chance by however small a ratio: 6,000 cells against 5,400 is 1.11x, 5.6 sigma.
-  std::vector<SearchLead> many = wide;
-  many[0].found.best.telling_inliers = 6000;
-  many[0].found.next_score = 5400;
-  v = decide({right, along}, many, 0.1);
-  EXPECT_EQ(v.answer, 0) << v.reason;
-  EXPECT_EQ(v.on, CandidateVerdict::On::corroborated);
-
-  // A pose the other map's empty space contradicts is not a right answer
-  // with its copy: 24 % as many telling cells in that space as on its
-  // occupancy (both ways, as the climb lands it) against at most 20 %.
-  Candidate contradicted = right;
-  contradicted.landed.telling_inliers = 1000, contradicted.landed.contradicted = 240;
-  v = decide({contradicted, along}, wide, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("it lands 24 % as many telling cells in space the other map saw empty"), std::string::npos)
-      << v.reason;
-  contradicted.landed.contradicted = 200;
-  EXPECT_EQ(decide({contradicted, along}, wide, 0.1).answer, 0);
-
-  // No slice-pair estimate there: the occupancy's word alone, which is not clear.
-  Candidate unvoted = right;
-  unvoted.feature_votes.clear();
-  v = decide({unvoted, along}, wide, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("no slice-pair estimate of the features agrees"), std::string::npos) << v.reason;
-
-  // The dense search's own best is the copy along the wall (rank 0), this is
-  // its runner-up: the two looks at the occupancy disagree.
-  Candidate runner_up = right;
-  runner_up.rank = 1;
-  along.rank = 0;
-  v = decide({runner_up, along}, wide, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("no dense search's best pose is at its place"), std::string::npos) << v.reason;
-
-  // The features' own answer is not a dense search: it corroborates nothing by itself.
-  Candidate from_features = right;
-  from_features.from = Candidate::From::features;
-  along.rank = 1;
-  along.from = Candidate::From::feature_rival;
-  v = decide({from_features, along}, wide, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("no dense search of the occupancy"), std::string::npos) << v.reason;
+// The decision, row by row: each way it answers (steps 3-5 of
+// docs/algorithm.md, "One decision") and each way one falls short, with the
+// reason it gives.
+TEST(CandidateDecision, TruthTable) {
+  for (const Row& row : truthTable()) {
+    SCOPED_TRACE(row.what);
+    const CandidateVerdict v = decide(row.candidates, row.searches, row.grid);
+    EXPECT_EQ(v.answer, row.answer) << v.reason;
+    if (row.answer >= 0) {
+      EXPECT_EQ(v.on, row.on);
+      EXPECT_TRUE(v.reason.empty()) << v.reason;
+    } else {
+      EXPECT_FALSE(v.reason.empty() && !v.needs_look);
+      EXPECT_NE(v.reason.find(row.reason), std::string::npos) << v.reason;
+    }
+    EXPECT_EQ(v.needs_look, row.needs_look);
+  }
 }
 
-// A room at g 0.1: the right pose and a copy of it a wall along land alike
-// slice by slice, and no feature estimate tells them apart; the search of
-// the whole occupancy puts its own best pose at the right one, far ahead of
-// its next, and finds it again with the maps' roles swapped.
-TEST(CandidateDecision, TheOccupancysBestPlaceAnswersWhereASearchsClearBestIsFoundAgainBothWays) {
-  const std::vector<Candidate> c{landing(0, 0, 0, 6, {62, 55, 70}), landing(0.6, 0, 0, 6, {60, 56, 66})};
-  std::vector<SearchLead> searches{searchLead(Candidate::From::search_at_grid, 0.05, 0, 0, 900, 300)};
-  CandidateVerdict v = decide(c, searches, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  ASSERT_TRUE(v.needs_look.has_value()) << "the look decides, so the decision asks for it: " << v.reason;
-  EXPECT_EQ(*v.needs_look, Candidate::From::search_at_grid);
-
-  searches[0].look = SecondLook{true, true, 0.02};
-  v = decide(c, searches, 0.1);
-  ASSERT_EQ(v.answer, 0) << v.reason;
-  EXPECT_EQ(v.on, CandidateVerdict::On::second_look);
-  EXPECT_FALSE(v.needs_look);
-  EXPECT_NEAR(v.lead_sigma, 600 / std::sqrt(1200.0), 1e-9) << "the search's lead over its next";
-
-  // Asked again the other way round, the search finds another place: no answer, and the reason says so.
-  searches[0].look = SecondLook{true, false, 2.4};
-  v = decide(c, searches, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_FALSE(v.needs_look);
-  EXPECT_NE(v.reason.find("search_at_grid with the maps' roles swapped found another place, 2.40 m apart"),
-            std::string::npos)
-      << v.reason;
-
-  // The pooled search's best pose is there too: where the grid's look fails, the decision asks for the pooled one's.
-  SearchLead pooled = searches[0];
-  pooled.from = Candidate::From::search_pooled;
-  pooled.pooling = 2;
-  pooled.look.reset();
-  searches.push_back(pooled);
-  v = decide(c, searches, 0.1);
-  ASSERT_TRUE(v.needs_look.has_value()) << v.reason;
-  EXPECT_EQ(*v.needs_look, Candidate::From::search_pooled);
-  searches[1].look = SecondLook{false, false, 0.0};
-  v = decide(c, searches, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("search_pooled with the maps' roles swapped found no pose"), std::string::npos) << v.reason;
-}
-
-TEST(CandidateDecision, ASearchsBestPoseNotClearOfItsNextOrClearlyElsewhereDoesNotAnswer) {
-  const std::vector<Candidate> c{landing(0, 0, 0, 6, {62, 55, 70}), landing(0.6, 0, 0, 6, {60, 56, 66})};
-  SearchLead grid = searchLead(Candidate::From::search_at_grid, 0, 0, 0, 900, 300);
-  grid.look = SecondLook{true, true, 0.0};
-
-  // 1.3x ahead of its next: not clear of it, however often it is found again.
-  SearchLead close = grid;
-  close.found.next_score = 900 / 1.3;
-  CandidateVerdict v = decide(c, {close}, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_FALSE(v.needs_look);
-  // Clear, but on fewer slices than min_support: a floor alone.
-  SearchLead thin = grid;
-  thin.found.best.support = MatchParams{}.min_support - 1;
-  v = decide(c, {thin}, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_FALSE(v.needs_look);
-
-  // The wide search is not looked at again (it never answers alone), but
-  // its clear best pose elsewhere tells against the place: a real RGB-D
-  // crop's pooled best, found again both ways, was wrong where the grid's
-  // best lay elsewhere, 1.96x ahead.
-  const SearchLead wide_elsewhere = searchLead(Candidate::From::search_wide, 3, 1, 1.5, 500, 200);
-  v = decide(c, {grid, wide_elsewhere}, 0.1);
-  EXPECT_EQ(v.answer, -1);
-  EXPECT_NE(v.reason.find("search_wide's best pose lies elsewhere, 2.50x ahead of its next"), std::string::npos)
-      << v.reason;
-  const SearchLead wide_here = searchLead(Candidate::From::search_wide, 0, 0, 0, 500, 200);
-  v = decide(c, {wide_here}, 0.1);
-  EXPECT_EQ(v.answer, -1) << "the wide search alone has no second look";
-  EXPECT_FALSE(v.needs_look);
-  v = decide(c, {wide_here, grid}, 0.1);
-  EXPECT_EQ(v.answer, 0) << v.reason;
-
-  // A pooled search's best pose is a whole number of pooled slices high: a
-  // slice above the place is still at it.
-  SearchLead pooled = grid;
-  pooled.from = Candidate::From::search_pooled;
-  pooled.pooling = 2;
-  pooled.found.best.offset = kSmearSlices / 2 + 1;
-  v = decide(c, {pooled}, 0.1);
-  EXPECT_EQ(v.answer, 0) << v.reason;
-}
-
-// The pose a second look vouches for is the search's own best; where
-// another candidate at its place lands a little more (a real RGB-D crop at
-// g 0.1, sunrgbd-room-38: the grid's runner-up climbed onto one slice 0.64 m
-// off and landed more than the wide search's best, 0.10 m off), the
-// search's pose is answered, not the one that lands the most.
-TEST(CandidateDecision, ASecondLookAnswersThePoseItFoundAgain) {
-  Candidate most = landing(0.3, 0, 0, 6, {63, 54, 71}), searched = landing(0, 0, 0, 6, {62, 55, 70}),
-            copy = landing(1.2, 0, 0, 6, {60, 56, 66});
-  most.from = Candidate::From::search_pooled, most.rank = 1;
-  searched.from = Candidate::From::search_at_grid;
-  copy.from = Candidate::From::search_wide;
-  SearchLead grid = searchLead(Candidate::From::search_at_grid, 0, 0, 0, 900, 300);
-  grid.look = SecondLook{true, true, 0.02};
-  const CandidateVerdict v = decide({most, searched, copy}, {grid}, 0.1);
-  ASSERT_EQ(v.on, CandidateVerdict::On::second_look) << v.reason;
-  EXPECT_EQ(v.answer, 1) << "the grid's own best, as it climbed";
+TEST(CandidateDecision, AnAnswerSaysHowClearItIsAndOverHowManySlices) {
+  const std::vector<Row> table = truthTable();
+  const CandidateVerdict occupancy = decide(table[0].candidates, {}, 0.1);
+  EXPECT_GE(occupancy.lead_sigma, kBars.significant);
+  EXPECT_EQ(occupancy.slices, 20);
+  const CandidateVerdict corroborated = decide(table[5].candidates, table[5].searches, 0.1);
+  ASSERT_EQ(corroborated.on, On::corroborated);
+  EXPECT_LT(corroborated.lead_sigma, kBars.significant) << "the occupancy alone does not tell them apart";
+  const CandidateVerdict second_look = decide({right(), along()}, {gridFoundAgain()}, 0.1);
+  ASSERT_EQ(second_look.on, On::second_look);
+  EXPECT_NEAR(second_look.lead_sigma, 600 / std::sqrt(1200.0), 1e-9) << "the search's lead over its next";
+  const CandidateVerdict pooled = decide(table[4].candidates, {}, 0.05);
+  EXPECT_EQ(pooled.slices, 20) << "the place's lead, on the pooled slices";
+  const CandidateVerdict none = decide({}, {}, 0.1);
+  EXPECT_EQ(none.answer, -1);
+  EXPECT_EQ(none.reason, "no candidate pose");
 }
