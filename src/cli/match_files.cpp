@@ -5,7 +5,6 @@
 #include <exception>
 #include <future>
 #include <iostream>
-#include <map>
 #include <optional>
 
 #include "core/map_bounds.hpp"

@@ -19,10 +19,6 @@ bool consistent(const DensePose& p) { return contradiction(p) <= kBars.most_cont
 
 bool holdsOver(const DensePose& p, int min_support) { return consistent(p) && p.support >= min_support; }
 
-double looksApart(const MatchParams& params, double grid) {
-  return std::sqrt(2.0) * params.consensus_translation_cells * grid;
-}
-
 double DenseEvidence::lead() const { return best.score() <= 0 ? 0 : best.score() / std::max(next_score, 1.0); }
 
 double DenseEvidence::leadSigma() const { return significance(best.score(), next_score); }

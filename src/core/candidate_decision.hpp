@@ -55,18 +55,11 @@ bool consistent(const DensePose& p);
 /// Whether a pose is consistent over at least `min_support` slices.
 bool holdsOver(const DensePose& p, int min_support);
 
-/// How far apart two looks at one pose (two proposals of it, or one search
-/// with the maps' roles swapped) may place it and still be looks at one
-/// place [m]: two looks of equal spread lie sqrt(2) times one's error apart,
-/// so within sqrt(2) consensus tolerances, each is within the tolerance.
-double looksApart(const MatchParams& params, double grid);
-
 /// What one dense search says of its own best pose: how far ahead of its next.
 struct DenseEvidence {
   bool found = false;     ///< searched, and found at least one pose
   DensePose best;         ///< its best pose (found only)
   double next_score = 0;  ///< its next pose's score; 0 if it found one only
-  double cell = 0;        ///< of the occupancy searched [m]
 
   /// The best pose's score over its next's; 0 where even the best contradicts more than it finds.
   double lead() const;

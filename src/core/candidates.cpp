@@ -4,7 +4,6 @@
 #include <cmath>
 #include <optional>
 
-#include "candidate_decision.hpp"
 #include "dense_refine.hpp"
 #include "height_offsets.hpp"
 #include "nearby_poses.hpp"
@@ -101,14 +100,15 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
   // pixel-quantised pose where the occupancy says, as a climb would, at a
   // fraction of the time; on small maps the ICP in place of the climb
   // answered fewer right and one wrong (docs/results.md, "Candidates on
-  // large maps"). Two proposals are one place within looksApart at the
-  // source's centre and the smear of heights.
+  // large maps"). Two proposals are one place within sqrt(2) consensus
+  // tolerances at the source's centre and the smear of heights: two looks
+  // at one place of equal spread lie sqrt(2) times one's error apart.
   std::vector<size_t> order(out.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return out[a].proposed_landed.score() > out[b].proposed_landed.score(); });
   ConsensusParams same = consensusParams(params, target.grid);
-  same.translation_tolerance = looksApart(params, target.grid);
+  same.translation_tolerance = std::sqrt(2.0) * same.translation_tolerance;
   const Eigen::Vector2d centre = source.occupancy.grid.centre();
   const bool small = denseSearchable(target.occupancy) && denseSearchable(source.occupancy);
   const OccupancyRefiner icp(target.occupancy, source.occupancy);  // one preparation for every climb or ICP

@@ -1,6 +1,5 @@
 #include "dense_opinion.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <tuple>
@@ -15,7 +14,6 @@ namespace {
 /// What one dense search found, its poses' offsets in the map's own slices.
 struct Opinion {
   DenseSearch search;
-  double cell = 0;       ///< of the occupancy searched [m]
   int pooling = 1;       ///< the map's slices per slice searched
   ConsensusParams same;  ///< when two poses are the same, at that cell
 
@@ -45,7 +43,7 @@ Opinion searchAt(const MapFeatures& target, const MapFeatures& source, const Sli
                  int pooling, const MatchParams& params, DenseSearchParams dp = {}) {
   dp.threads = matchThreads(params);
   const ConsensusParams same = consensusParams(params, t.grid.cell);
-  Opinion o{searchDensely(t, s, same, source.centre(), dp), t.grid.cell, pooling, same};
+  Opinion o{searchDensely(t, s, same, source.centre(), dp), pooling, same};
   const int shift = firstSlice(t, target.occupancy, pooling) - firstSlice(s, source.occupancy, pooling);
   for (DensePose& p : o.search.poses) p.offset = p.offset * pooling + shift;
   if (pooling > 1 && !o.search.poses.empty()) {
@@ -69,7 +67,6 @@ bool isBestPose(const Opinion& o, const Rigid2D& a, int offset, const MapFeature
 DenseEvidence evidenceOf(const Opinion& o) {
   DenseEvidence d;
   d.found = o.found();
-  d.cell = o.cell;
   if (!d.found) return d;
   d.best = o.best();
   d.next_score = o.nextScore();
@@ -135,14 +132,18 @@ CandidateVerdict decide(MatchResult& r, const FeatureProposals& f, const std::op
   }
   e.candidates = refineAndLand(target, source, proposals, params, f.votes);
   CandidateVerdict v;
+  // The decision asks for the second look of a search on the maps' own
+  // cells (at the grid, pooled: those ran on the full slices), one at a time.
   while ((v = decideOnCandidates(e, params)).needs_look) {
-    const Candidate::From which = *v.needs_look;
+    const bool by_pooled = *v.needs_look == Candidate::From::search_pooled;
+    const std::optional<Opinion>& o = by_pooled ? at_pooled : at_grid;
+    if (!o || !ft) break;  // not a search it can ask (the wide one never answers alone)
     for (SearchLead& l : e.searches)
-      if (l.from == which) {
-        l.look = which == Candidate::From::search_pooled
-                     ? lookAgain(*at_pooled, target, source, pooled(*ft), pooled(*fs), params)
-                     : lookAgain(*at_grid, target, source, *ft, *fs, params);
-        if (l.look->found && !r.dense.second_look_apart) r.dense.second_look_apart = l.look->apart;
+      if (l.from == *v.needs_look) {
+        l.look = by_pooled ? lookAgain(*o, target, source, pooled(*ft), pooled(*fs), params)
+                           : lookAgain(*o, target, source, *ft, *fs, params);
+        // The look asked last is the one whose search would answer.
+        r.dense.second_look_apart = l.look->found ? std::optional<double>(l.look->apart) : std::nullopt;
       }
   }
   r.candidates = std::move(e.candidates);

@@ -541,12 +541,6 @@ std::vector<std::vector<SliceLanding>> PoseLander::slices(const Poses& poses) co
 
 int PoseLander::heightOffset(const Rigid2D& T, int middle, int reach) const { return height_(T, middle, reach); }
 
-std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& source,
-                                 const std::vector<std::pair<Rigid2D, int>>& poses, const DenseSearchParams& params) {
-  if (poses.empty()) return {};
-  return PoseLander(target, source, params)(poses);
-}
-
 DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset) { return land({{T, offset}}).front(); }
 
 DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,

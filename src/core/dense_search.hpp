@@ -19,9 +19,9 @@ struct DenseSearchParams {
   double yaw_step = radians(3.0);  ///< [rad]; 3 deg moves a point 3 m out by 0.16 m, under one coarse cell
   int candidates = 12;             ///< distinct coarse poses refined on the full grid
   /// Source cells each coarse pose's ICP uses at most (evenly thinned):
-  /// that refinement ranks the search's poses, and a pose that answers, or a
-  /// candidate that climbs, is refined again on up to
-  /// DenseRefineParams::max_cells (nearby_poses.hpp). What a quarter of those
+  /// that refinement ranks the search's poses, and each of them, as a
+  /// candidate, climbs again on up to DenseRefineParams::max_cells
+  /// (nearby_poses.hpp). What a quarter of those
   /// cells changed: docs/results.md, "A search's poses refined on fewer cells".
   size_t refine_cells = 10000;
   double inlier_radius_cells = 1.5;  ///< [grid cells]
@@ -48,7 +48,7 @@ constexpr int kMaxCoarsening = 6;
 /// 2.2 m, a road's width. Its best pose proposes candidates and corroborates
 /// one, but does not answer on its own second look (candidate_decision.cpp).
 /// Its coarse cell stays 2 grid cells or more: at 1, on rooms at g 0.1, it
-/// cost 2.5 times the usual search and confirmed no more.
+/// cost 2.5 times the usual search and answered no more rooms.
 constexpr int kWideCoarseSide = 64;
 constexpr int kWideMinCoarsening = 2;
 
@@ -108,11 +108,6 @@ int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, co
 DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                    const DenseSearchParams& params = {});
 
-/// landPose for several poses (T, offset), the maps' occupancy prepared once.
-std::vector<DensePose> landPoses(const SliceStack& target, const SliceStack& source,
-                                 const std::vector<std::pair<Rigid2D, int>>& poses,
-                                 const DenseSearchParams& params = {});
-
 /// How a pose lands one source slice's cells on the target (landPose's counts, slice by slice).
 struct SliceLanding {
   int slice = 0;         ///< source slice index
@@ -131,7 +126,7 @@ std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, cons
                                                   const std::vector<std::pair<Rigid2D, int>>& poses,
                                                   const DenseSearchParams& params = {});
 
-/// landPoses with the maps' occupancy prepared once for every call, for a
+/// landPose with the maps' occupancy prepared once for every call, for a
 /// caller that lands poses again and again (a climb, nearby_poses.hpp). The
 /// stacks must outlive it.
 class PoseLander {

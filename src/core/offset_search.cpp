@@ -29,8 +29,8 @@ constexpr size_t kSamplesPerOffset = 8;
 /// An offset is matched in full once its sampled support, scaled to its whole
 /// diagonal, reaches this share of the best full support so far: a sample of
 /// 8 pairs misjudges an offset's support by up to about half (synth street
-/// and building, demo-room), and a rival with 0.8 of the winner's support
-/// is one to propose (rival_answers.hpp).
+/// and building, demo-room): at half the best, every rival with support
+/// near the winner's is matched in full and proposed (rival_answers.hpp).
 constexpr double kRivalShare = 0.5;
 
 /// A winner under this many times min_support is checked against every pair:

@@ -1,6 +1,6 @@
 // The regression matrix (tests/suites/matrix.toml) as a gate: no family of
 // maps may answer wrong, nor fewer right than it did when its floor below was
-// last raised. A verdict change that breaks a family it was not made for fails
+// last raised. A change to the decision that breaks a family it was not made for fails
 // here, not in a user's hands (docs/results.md has the whole table).
 #include <gtest/gtest.h>
 

@@ -266,10 +266,10 @@ TEST(Cli, FpfhRansacBaselineRunsOnTheSamePair) {
   EXPECT_EQ(test::runBinary(TOMOMAP_BASELINE_BIN, "/nonexistent.pcd b.pcd").exit_code, 2);
 }
 
-// The paper's method as published has no verdict: on a small room it answers
+// The paper's method as published has no decision: on a small room it answers
 // a copy of the room metres off, where tomomap answers right (the matrix in
 // docs/results.md counts both over every family).
-TEST(Cli, PaperConsensusBaselineAnswersWithoutAVerdict) {
+TEST(Cli, PaperConsensusBaselineAnswersWithoutADecision) {
   TempDir dir;
   const std::string w = dir / "room";
   ASSERT_EQ(runTomomap("synth --world room --seed 1 --noise low --out " + w).exit_code, 0);

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <tuple>
 
-#include "core/candidate_decision.hpp"
 #include "core/candidates.hpp"
 #include "core/dense_refine.hpp"
 #include "core/dense_search.hpp"
@@ -169,8 +168,8 @@ TEST(DenseSearch, AStoreyAboveEnclosesNothingInTheOneBelow) {
 // Two crops of one room sharing a fifth of it, at the right pose: a slice
 // cannot land half of all its cells on the other crop (most lie where the
 // other never looked), but it lands half of those that fall where the other
-// saw anything. support_seen is what confirms a thin feature answer on a
-// partial overlap (verdict.hpp).
+// saw anything: support_seen, what a slice holds over on a partial overlap
+// (DensePose::support_seen).
 TEST(DenseSearch, ASliceOfAPartialCropHoldsOnTheCellsThatLandWhereTheOtherMapSawAnything) {
   const Points room = roomScan();
   std::vector<float> xs;

@@ -233,7 +233,7 @@ TEST(SixDofFinish, RefusesEmptyStacksWithAReason) {
 }
 
 /// A finish of a wrong start is no search: it keeps the start, or moves it
-/// no farther than a finish may (the verdict judged the start, not where a
+/// no farther than a finish may (the decision judged the start, not where a
 /// search would have gone), and says why where it keeps it.
 void expectStaysNear(const SixDofFinish& f, const Eigen::Matrix4d& start) {
   const SixDofFinishParams bounds;
