@@ -79,7 +79,15 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
   if (proposals.empty()) return {};
   DenseSearchParams dp;
   dp.threads = matchThreads(params);
-  const PoseLander land(target.occupancy, source.occupancy, dp);
+  return refineAndLand(PoseLander(target.occupancy, source.occupancy, dp), target, source, proposals, params, votes);
+}
+
+std::vector<Candidate> refineAndLand(const PoseLander& land, const MapFeatures& target, const MapFeatures& source,
+                                     const std::vector<Proposal>& proposals, const MatchParams& params,
+                                     const FeatureVotes& votes) {
+  if (proposals.empty()) return {};
+  DenseSearchParams dp;
+  dp.threads = matchThreads(params);
   std::vector<std::pair<Rigid2D, int>> poses;
   for (const Proposal& p : proposals) poses.emplace_back(p.T, p.offset);
   const std::vector<DensePose> as_proposed = land(poses);
@@ -111,7 +119,6 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
   same.translation_tolerance = std::sqrt(2.0) * same.translation_tolerance;
   const Eigen::Vector2d centre = source.occupancy.grid.centre();
   const bool small = denseSearchable(target.occupancy) && denseSearchable(source.occupancy);
-  const OccupancyRefiner icp(target.occupancy, source.occupancy);  // one preparation for every climb or ICP
   DenseRefineParams rp;
   rp.threads = dp.threads;
   std::vector<size_t> refined;
@@ -123,8 +130,8 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
     });
     if (seen) continue;
     refined.push_back(i);
-    c.landed = small ? uphill(land, icp, c.proposed, c.proposed_offset, dp.threads)
-                     : landPose(land, icp(c.proposed_offset, c.proposed, rp).transform, c.proposed_offset);
+    c.landed = small ? uphill(land, c.proposed, c.proposed_offset, dp.threads)
+                     : landPose(land, land.refiner()(c.proposed_offset, c.proposed, rp).transform, c.proposed_offset);
   }
   // Each at the height where most of the source's occupancy lands, within
   // half the smear of heights either side of its own: a climb and the

@@ -67,5 +67,10 @@ struct Proposal {
 std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeatures& source,
                                      const std::vector<Proposal>& proposals, const MatchParams& params,
                                      const FeatureVotes& votes = {});
+/// refineAndLand with `land`, the lander of the maps' occupancy
+/// (target.occupancy, source.occupancy) the caller has prepared already.
+std::vector<Candidate> refineAndLand(const PoseLander& land, const MapFeatures& target, const MapFeatures& source,
+                                     const std::vector<Proposal>& proposals, const MatchParams& params,
+                                     const FeatureVotes& votes = {});
 
 }  // namespace tomomap

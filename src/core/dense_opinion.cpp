@@ -39,11 +39,13 @@ int firstSlice(const SliceStack& searched, const SliceStack& own, int pooling) {
 /// Searches `t` and `s` (the maps' occupancy, its full slices, or those
 /// pooled by `pooling`) with `dp`, and brings the best pose back to the maps'
 /// own grid: its offset in their slices, its transform refined on their cells.
+/// `land`, where given, is the lander of `t` and `s` already prepared.
 Opinion searchAt(const MapFeatures& target, const MapFeatures& source, const SliceStack& t, const SliceStack& s,
-                 int pooling, const MatchParams& params, DenseSearchParams dp = {}) {
+                 int pooling, const MatchParams& params, DenseSearchParams dp = {}, const PoseLander* land = nullptr) {
   dp.threads = matchThreads(params);
   const ConsensusParams same = consensusParams(params, t.grid.cell);
-  Opinion o{searchDensely(t, s, same, source.centre(), dp), pooling, same};
+  Opinion o{land ? searchDensely(*land, same, source.centre(), dp) : searchDensely(t, s, same, source.centre(), dp),
+            pooling, same};
   const int shift = firstSlice(t, target.occupancy, pooling) - firstSlice(s, source.occupancy, pooling);
   for (DensePose& p : o.search.poses) p.offset = p.offset * pooling + shift;
   if (pooling > 1 && !o.search.poses.empty()) {
@@ -114,8 +116,12 @@ CandidateVerdict decide(MatchResult& r, const FeatureProposals& f, const std::op
     if (2 * target.grid <= kBars.coarsest_pooled_cell + 1e-9)
       at_pooled = searchAt(target, source, pooled(*ft), pooled(*fs), 2, params);
   }
+  // The maps' occupancy prepared once for the wide search and the candidates.
+  DenseSearchParams dp;
+  dp.threads = matchThreads(params);
+  const PoseLander land(target.occupancy, source.occupancy, dp);
   if (denseSearchable(target.occupancy, wideSearch()) && denseSearchable(source.occupancy, wideSearch()))
-    wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch());
+    wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch(), &land);
   DecisionEvidence e;
   e.grid = target.grid;
   e.source_centre = source.occupancy.grid.centre();
@@ -130,7 +136,7 @@ CandidateVerdict decide(MatchResult& r, const FeatureProposals& f, const std::op
     e.searches.push_back({from, evidenceOf(**o), (*o)->pooling, {}});
     *lead = e.searches.back().found.lead();
   }
-  e.candidates = refineAndLand(target, source, proposals, params, f.votes);
+  e.candidates = refineAndLand(land, target, source, proposals, params, f.votes);
   CandidateVerdict v;
   // The decision asks for the second look of a search on the maps' own
   // cells (at the grid, pooled: those ran on the full slices), one at a time.

@@ -24,7 +24,7 @@ double DensePose::score() const {
   return static_cast<double>(telling_inliers) - kContradictionWeight * static_cast<double>(contradicted);
 }
 
-namespace {
+namespace dense_detail {
 
 int coarsening(const SliceStack& s, int side) {
   const int longest = std::max({s.grid.width, s.grid.height, s.size()});
@@ -480,7 +480,9 @@ void forEachLanding(const PoseJudge& judge, const PoseLander::Poses& poses, cons
   }
 }
 
-}  // namespace
+}  // namespace dense_detail
+
+using namespace dense_detail;
 
 std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, const SliceStack& source,
                                                   const std::vector<std::pair<Rigid2D, int>>& poses,
@@ -488,58 +490,53 @@ std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, cons
   return PoseLander(target, source, params).slices(poses);
 }
 
-PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params) {
-  const auto judge = std::make_shared<const PoseJudge>(target, source, params);
-  const int threads = std::max(1, params.threads);
-  land_ = [judge, threads](const Poses& poses) {
-    std::vector<DensePose> out(poses.size());
-    forEachLanding(*judge, poses, judge->source_cells, judge->target_cells, threads,
-                   [&](size_t n, const std::vector<int>& forth, const std::vector<int>& back) {
-                     DensePose& p = out[n];
-                     p.transform = poses[n].first, p.offset = poses[n].second;
-                     PoseJudge::judge(p, judge->forth(forth, p.offset), judge->backwards(back, p.offset));
-                   });
-    return out;
-  };
-  score_ = [judge, threads](const Poses& poses) {
-    std::vector<double> out(poses.size());
-    forEachLanding(*judge, poses, judge->source_telling, judge->target_telling, threads,
-                   [&](size_t n, const std::vector<int>& forth, const std::vector<int>& back) {
-                     out[n] = judge->score(poses[n].first, poses[n].second, forth, back);
-                   });
-    return out;
-  };
-  slices_ = [judge, threads](const Poses& poses) {
-    std::vector<std::vector<SliceLanding>> out(poses.size());
-#pragma omp parallel for schedule(dynamic) num_threads(threads)
-    for (size_t n = 0; n < poses.size(); ++n)
-      judge->forth(landings(judge->source_cells, poses[n].first, judge->target.grid), poses[n].second, &out[n]);
-    return out;
-  };
+PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params)
+    : judge_(std::make_shared<const PoseJudge>(target, source, params)),
+      refine_(std::make_shared<const OccupancyRefiner>(target, source)),
+      threads_(std::max(1, params.threads)) {
   // On maps a dense search reaches (the wide one's bound: BitColumns take a
-  // word a pixel per 64 slices, at most a few MB there) a candidate's height
-  // is read down the target's columns; on larger ones, slice by slice.
+  // word a pixel per 64 slices, at most a few MB there) a pose's height is
+  // read down the target's columns; on larger ones, slice by slice.
   DenseSearchParams widest = params;
   widest.coarse_side = std::max(params.coarse_side, kWideCoarseSide);
-  if (!denseSearchable(target, widest)) {
-    height_ = [judge](const Rigid2D& T, int middle, int reach) {
-      return mostInliersNear(SliceWindows{judge->dilated}, judge->source_cells, judge->target.grid, T, middle, reach);
-    };
-    return;
-  }
-  const auto columns = std::make_shared<const BitColumns>(columnsOf(judge->dilated, target.grid));
-  height_ = [judge, columns](const Rigid2D& T, int middle, int reach) {
-    return mostInliersNear(*columns, judge->source_cells, judge->target.grid, T, middle, reach);
-  };
+  if (denseSearchable(target, widest))
+    columns_ = std::make_shared<const BitColumns>(columnsOf(judge_->dilated, target.grid));
 }
 
-std::vector<DensePose> PoseLander::operator()(const Poses& poses) const { return land_(poses); }
+std::vector<DensePose> PoseLander::operator()(const Poses& poses) const {
+  std::vector<DensePose> out(poses.size());
+  forEachLanding(*judge_, poses, judge_->source_cells, judge_->target_cells, threads_,
+                 [&](size_t n, const std::vector<int>& forth, const std::vector<int>& back) {
+                   DensePose& p = out[n];
+                   p.transform = poses[n].first, p.offset = poses[n].second;
+                   PoseJudge::judge(p, judge_->forth(forth, p.offset), judge_->backwards(back, p.offset));
+                 });
+  return out;
+}
 
-std::vector<double> PoseLander::scores(const Poses& poses) const { return score_(poses); }
+std::vector<double> PoseLander::scores(const Poses& poses) const {
+  std::vector<double> out(poses.size());
+  forEachLanding(*judge_, poses, judge_->source_telling, judge_->target_telling, threads_,
+                 [&](size_t n, const std::vector<int>& forth, const std::vector<int>& back) {
+                   out[n] = judge_->score(poses[n].first, poses[n].second, forth, back);
+                 });
+  return out;
+}
 
-std::vector<std::vector<SliceLanding>> PoseLander::slices(const Poses& poses) const { return slices_(poses); }
+std::vector<std::vector<SliceLanding>> PoseLander::slices(const Poses& poses) const {
+  std::vector<std::vector<SliceLanding>> out(poses.size());
+#pragma omp parallel for schedule(dynamic) num_threads(threads_)
+  for (size_t n = 0; n < poses.size(); ++n)
+    judge_->forth(landings(judge_->source_cells, poses[n].first, judge_->target.grid), poses[n].second, &out[n]);
+  return out;
+}
 
-int PoseLander::heightOffset(const Rigid2D& T, int middle, int reach) const { return height_(T, middle, reach); }
+int PoseLander::heightOffset(const Rigid2D& T, int middle, int reach) const {
+  if (columns_) return mostInliersNear(*columns_, judge_->source_cells, judge_->target.grid, T, middle, reach);
+  return mostInliersNear(SliceWindows{judge_->dilated}, judge_->source_cells, judge_->target.grid, T, middle, reach);
+}
+
+const OccupancyRefiner& PoseLander::refiner() const { return *refine_; }
 
 DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset) { return land({{T, offset}}).front(); }
 
@@ -560,9 +557,16 @@ bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params) {
 
 DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, const ConsensusParams& same,
                           const Eigen::Vector2d& pivot, const DenseSearchParams& params) {
+  if (!denseSearchable(target, params) || !denseSearchable(source, params)) return {};
+  return searchDensely(PoseLander(target, source, params), same, pivot, params);
+}
+
+DenseSearch searchDensely(const PoseLander& land, const ConsensusParams& same, const Eigen::Vector2d& pivot,
+                          const DenseSearchParams& params) {
   DenseSearch out;
+  const PoseJudge& judge = *land.judge_;
+  const SliceStack &target = judge.target, &source = judge.source;
   if (!denseSearchable(target, params) || !denseSearchable(source, params)) return out;
-  const PoseJudge judge(target, source, params);
   const std::vector<Cell>& source_cells = judge.source_cells;
   if (source_cells.empty()) return out;
   out.searched = true;
@@ -594,6 +598,18 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
     for (size_t k = 0; k < timg.size(); ++k) spectrumOf(timg[k], padded, big, tspec[k]);
   }
 
+  // The source's cells as the coarse raster sees them: one per pixel per
+  // coarse slice (a wall's pixel is occupied in most of a coarse slice's c
+  // slices, and lands on the same coarse pixel from each), each about the
+  // raster's centre. Every yaw step turns all of them.
+  std::vector<std::pair<Eigen::Vector2d, int>> coarse_cells;  // (cell - centre, coarse slice)
+  {
+    std::vector<int> last(static_cast<size_t>(sg.width) * static_cast<size_t>(sg.height), -1);
+    for (int k = 0; k < source.size(); ++k)
+      for (uint32_t idx : source.cells[static_cast<size_t>(k)])
+        if (int& seen = last[idx]; seen != k / c)
+          seen = k / c, coarse_cells.emplace_back(sg.cellCentre(idx) - centre, k / c);
+  }
   const int steps = std::max(1, static_cast<int>(std::lround(2.0 * kPi / params.yaw_step)));
   const size_t offsets = static_cast<size_t>(zs + zt - 1);
   std::vector<int> target_occupied(timg.size());  // coarse cells per slice: what bounds each offset's peak
@@ -616,11 +632,10 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
         const int step = todo[n];
         const double yaw = 2.0 * kPi * step / steps, cs = std::cos(yaw), sn = std::sin(yaw);
         for (auto& m : simg) m.setTo(0);
-        for (const Cell& cell : source_cells) {
-          const Eigen::Vector2d d = cell.p - centre;
+        for (const auto& [d, z] : coarse_cells) {
           const int u = static_cast<int>((cs * d.x() - sn * d.y() + radius) / C);
           const int v = static_cast<int>((sn * d.x() + cs * d.y() + radius) / C);
-          simg[static_cast<size_t>(cell.slice / c)].at<float>(v, u) = 1.f;
+          simg[static_cast<size_t>(z)].at<float>(v, u) = 1.f;
         }
         std::vector<int> source_occupied(simg.size());
         for (size_t k = 0; k < simg.size(); ++k) source_occupied[k] = cv::countNonZero(simg[k]);
@@ -691,8 +706,8 @@ DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, co
 
   // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
   std::vector<DensePose> refined(coarse.size());
-  const BitColumns columns = columnsOf(judge.dilated, tg);
-  const OccupancyRefiner refine(target, source);
+  const BitColumns& columns = *land.columns_;  // the search reaches no farther than the lander's columns
+  const OccupancyRefiner& refine = land.refiner();
   DenseRefineParams refine_params;
   refine_params.max_cells = params.refine_cells;
   refine_params.threads = 1;  // the loop over the poses has them

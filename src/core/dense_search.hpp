@@ -1,11 +1,13 @@
 #pragma once
 // A dense search for small maps: every yaw, shift and height offset scored by
 // how much of the two maps' occupancy coincides, without features.
-#include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 
+#include "bit_raster.hpp"
 #include "consensus.hpp"
+#include "dense_refine.hpp"
 #include "rigid2d.hpp"
 #include "slices.hpp"
 
@@ -126,9 +128,16 @@ std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, cons
                                                   const std::vector<std::pair<Rigid2D, int>>& poses,
                                                   const DenseSearchParams& params = {});
 
-/// landPose with the maps' occupancy prepared once for every call, for a
-/// caller that lands poses again and again (a climb, nearby_poses.hpp). The
-/// stacks must outlive it.
+namespace dense_detail {
+/// What a pose is judged on, built once per pair of maps (dense_search.cpp).
+struct PoseJudge;
+}  // namespace dense_detail
+
+/// The two maps' occupancy prepared once for judging and refining poses on
+/// it, for a caller that does so again and again (a climb, nearby_poses.hpp; a
+/// dense search and the candidates on the same maps: preparing it took a
+/// tenth of a room pair's match at 0.05 m cells, each time). The stacks must
+/// outlive it.
 class PoseLander {
  public:
   using Poses = std::vector<std::pair<Rigid2D, int>>;  ///< (T, offset) each
@@ -143,12 +152,17 @@ class PoseLander {
   std::vector<std::vector<SliceLanding>> slices(const Poses& poses) const;
   /// occupancyHeightOffset on the occupancy prepared.
   int heightOffset(const Rigid2D& T, int middle, int reach) const;
+  /// refineOnOccupancy on the same two stacks (dense_refine.hpp), prepared with them.
+  const OccupancyRefiner& refiner() const;
 
  private:
-  std::function<std::vector<DensePose>(const Poses&)> land_;
-  std::function<std::vector<double>(const Poses&)> score_;
-  std::function<std::vector<std::vector<SliceLanding>>(const Poses&)> slices_;
-  std::function<int(const Rigid2D&, int, int)> height_;
+  friend DenseSearch searchDensely(const PoseLander& land, const ConsensusParams& same, const Eigen::Vector2d& pivot,
+                                   const DenseSearchParams& params);
+  std::shared_ptr<const dense_detail::PoseJudge> judge_;
+  std::shared_ptr<const OccupancyRefiner> refine_;
+  std::shared_ptr<const BitColumns>
+      columns_;  ///< down the target's columns; null on maps the wide search does not reach
+  int threads_ = 1;
 };
 
 /// landPose with a lander: (T, offset) landed.
@@ -161,5 +175,10 @@ DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset);
 /// offsets are within one coarse cell.
 DenseSearch searchDensely(const SliceStack& target, const SliceStack& source, const ConsensusParams& same,
                           const Eigen::Vector2d& pivot, const DenseSearchParams& params = {});
+/// searchDensely on the two stacks `land` prepared (made with the same
+/// params but for the coarse raster's), its preparation shared with what
+/// else lands poses on them.
+DenseSearch searchDensely(const PoseLander& land, const ConsensusParams& same, const Eigen::Vector2d& pivot,
+                          const DenseSearchParams& params = {});
 
 }  // namespace tomomap

@@ -60,10 +60,11 @@ DensePose climb(const PoseLander& land, const SliceGrid& source, double cell, co
 
 DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                  const DenseSearchParams& params) {
-  return uphill(PoseLander(target, source, params), OccupancyRefiner(target, source), T, offset, params.threads);
+  return uphill(PoseLander(target, source, params), T, offset, params.threads);
 }
 
-DensePose uphill(const PoseLander& land, const OccupancyRefiner& refine, const Rigid2D& T, int offset, int threads) {
+DensePose uphill(const PoseLander& land, const Rigid2D& T, int offset, int threads) {
+  const OccupancyRefiner& refine = land.refiner();
   const SliceGrid& source = refine.source().grid;
   const double cell = refine.target().grid.cell;
   DensePose top = climb(land, source, cell, landPose(land, T, offset));

@@ -18,9 +18,8 @@ namespace tomomap {
 /// (T, offset) itself, landed, where nothing uphill lands more.
 DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                  const DenseSearchParams& params = {});
-/// uphill with `land` and `refine`, a lander and a refiner of the same two
-/// stacks (dense_search.hpp, dense_refine.hpp) the caller has prepared
-/// already: one preparation serves every step of every climb on them.
-DensePose uphill(const PoseLander& land, const OccupancyRefiner& refine, const Rigid2D& T, int offset, int threads = 1);
+/// uphill with `land`, the two stacks' lander (dense_search.hpp) the caller
+/// has prepared already: one preparation serves every step of every climb on them.
+DensePose uphill(const PoseLander& land, const Rigid2D& T, int offset, int threads = 1);
 
 }  // namespace tomomap

@@ -43,50 +43,76 @@ Eigen::Vector3d latticeOf(const SliceGrid& g, const Eigen::Vector3d& p) {
   return {(p.x() - g.x_min) / g.cell - 0.5, (p.y() - g.y_min) / g.cell - 0.5, (p.z() - g.z_min) / g.cell};
 }
 
-/// Open-addressing hash of the occupied lattice cells (key -> cell index). The
-/// cells lie on a lattice, so a neighbour lookup is a probe of its key: no
-/// kd-tree. Linear probing in a table at most half full costs one or two
-/// probes, a few times cheaper than std::unordered_map's buckets.
-class LatticeIndex {
+/// The occupied cells of a stack, found by lattice position. A slice's cells
+/// are sorted by pixel index (SliceStack), so one row's cells are one short
+/// run of them: a table of where each row's run starts leaves a search of a
+/// few cells. It is built in one pass and a few hundred kB over the stack's
+/// own cells; a hash of every cell (24 MB of table) took 0.1 s of a room
+/// pair's 0.35 s before its first sweep at 0.05 m cells, most of it page faults.
+class CellLookup {
  public:
-  LatticeIndex(const SliceGrid& g, int slices, const std::vector<LatticeCell>& cells)
-      : width_(g.width), height_(g.height), slices_(slices) {
-    size_t capacity = 16;
-    while (capacity < 2 * cells.size()) capacity *= 2;
-    mask_ = capacity - 1;
-    keys_.assign(capacity, kEmpty);
-    values_.resize(capacity);
-    for (size_t i = 0; i < cells.size(); ++i) {
-      const uint64_t key = keyOf(cells[i].u, cells[i].v, cells[i].k);
-      size_t s = slotOf(key);
-      while (keys_[s] != kEmpty && keys_[s] != key) s = (s + 1) & mask_;
-      if (keys_[s] == key) continue;  // the first of equal keys stands
-      keys_[s] = key;
-      values_[s] = static_cast<uint32_t>(i);
+  explicit CellLookup(const SliceStack& s)
+      : stack_(s), rows_(static_cast<size_t>(s.grid.height) + 1), first_(static_cast<size_t>(s.size()) + 1, 0) {
+    starts_.resize(static_cast<size_t>(s.size()) * rows_);
+    const auto w = static_cast<uint32_t>(s.grid.width);
+    for (size_t k = 0; k < s.cells.size(); ++k) {
+      const std::vector<uint32_t>& cells = s.cells[k];
+      first_[k + 1] = first_[k] + cells.size();
+      uint32_t* start = starts_.data() + k * rows_;
+      size_t n = 0;
+      for (size_t v = 0; v < rows_; ++v) {
+        while (n < cells.size() && cells[n] / w < v) ++n;
+        start[v] = static_cast<uint32_t>(n);
+      }
     }
   }
+  /// Every cell's index: its place among all of the stack's cells, slice by slice.
+  size_t size() const { return first_.back(); }
   /// Index of the occupied cell at (u, v, k), or -1.
   int64_t find(int u, int v, int k) const {
-    if (u < 0 || v < 0 || k < 0 || u >= width_ || v >= height_ || k >= slices_) return -1;
-    const uint64_t key = keyOf(u, v, k);
-    for (size_t s = slotOf(key);; s = (s + 1) & mask_) {
-      if (keys_[s] == key) return values_[s];
-      if (keys_[s] == kEmpty) return -1;
-    }
+    const SliceGrid& g = stack_.grid;
+    if (u < 0 || v < 0 || k < 0 || u >= g.width || v >= g.height || k >= stack_.size()) return -1;
+    const std::vector<uint32_t>& cells = stack_.cells[static_cast<size_t>(k)];
+    const uint32_t* start = starts_.data() + static_cast<size_t>(k) * rows_ + static_cast<size_t>(v);
+    const auto begin = cells.begin() + start[0], end = cells.begin() + start[1];
+    const auto key = static_cast<uint32_t>(v) * static_cast<uint32_t>(g.width) + static_cast<uint32_t>(u);
+    const auto at = std::lower_bound(begin, end, key);
+    if (at == end || *at != key) return -1;
+    return static_cast<int64_t>(first_[static_cast<size_t>(k)] + static_cast<size_t>(at - cells.begin()));
+  }
+  /// The lattice position of cell `index`.
+  LatticeCell at(size_t index) const {
+    const auto k = static_cast<size_t>(std::upper_bound(first_.begin(), first_.end(), index) - first_.begin()) - 1;
+    const uint32_t pixel = stack_.cells[k][index - first_[k]];
+    const auto w = static_cast<uint32_t>(stack_.grid.width);
+    return {static_cast<int>(pixel % w), static_cast<int>(pixel / w), static_cast<int>(k)};
   }
 
  private:
-  static constexpr uint64_t kEmpty = ~uint64_t{0};
-  uint64_t keyOf(int u, int v, int k) const {
-    return (static_cast<uint64_t>(k) * static_cast<uint64_t>(height_) + static_cast<uint64_t>(v)) *
-               static_cast<uint64_t>(width_) +
-           static_cast<uint64_t>(u);
+  const SliceStack& stack_;
+  size_t rows_;                   ///< the raster's rows, and one past the last
+  std::vector<size_t> first_;     ///< per slice, the index of its first cell (and one past the last slice's)
+  std::vector<uint32_t> starts_;  ///< per slice, per row (and one past), where the row's cells start in the slice
+};
+
+/// Where a stack saw anything: the columns (u, v) with a cell in some slice.
+class SeenColumns {
+ public:
+  explicit SeenColumns(const SliceStack& s)
+      : width_(s.grid.width),
+        height_(s.grid.height),
+        seen_(static_cast<size_t>(width_) * static_cast<size_t>(height_)) {
+    for (const auto& cells : s.cells)
+      for (uint32_t index : cells) seen_[index] = true;
   }
-  size_t slotOf(uint64_t key) const { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 20) & mask_; }
-  int width_, height_, slices_;
-  size_t mask_ = 0;
-  std::vector<uint64_t> keys_;
-  std::vector<uint32_t> values_;
+  bool has(int u, int v) const {
+    return u >= 0 && v >= 0 && u < width_ && v < height_ &&
+           seen_[static_cast<size_t>(v) * static_cast<size_t>(width_) + static_cast<size_t>(u)];
+  }
+
+ private:
+  int width_, height_;
+  std::vector<bool> seen_;
 };
 
 /// A lattice step to a neighbour, and its length [cells].
@@ -120,22 +146,17 @@ struct Plane {
 struct Target {
   SliceGrid grid;
   int slices = 0;
-  std::vector<LatticeCell> cells;
-  LatticeIndex index;    ///< of `cells`
-  LatticeIndex columns;  ///< (u, v) of every column with a cell in some slice: where the target saw anything
+  CellLookup cells;
+  SeenColumns columns;  ///< where the target saw anything
   /// Steps out to the widest radius plus the half diagonal a position may sit off its cell.
   std::vector<Offset> search;
-  std::vector<Plane> planes;  ///< one per cell, fitted where a correspondence first needs it (fitted)
-  std::vector<uint8_t> fitted;
+  /// The planes fitted so far, each where a correspondence first needed it:
+  /// a map of 600,000 cells at 0.05 m needs a few tens of thousands, and a
+  /// plane for every cell (28 MB) took longer to allocate than a sweep.
+  std::vector<Plane> planes;
+  std::vector<uint32_t> plane_of;           ///< per cell, 1 + its plane's index in `planes`, 0 where none is fitted yet
   double normal_radius = 0, planarity = 0;  ///< SixDofFinishParams' [cells], [ratio]
 };
-
-std::vector<LatticeCell> columnsOf(const std::vector<LatticeCell>& cells) {
-  std::vector<LatticeCell> out;
-  out.reserve(cells.size());
-  for (const LatticeCell& c : cells) out.push_back({c.u, c.v, 0});
-  return out;
-}
 
 /// Fewer cells than this within the normal radius do not fit a plane (a plane
 /// crossing the radius-2 ball holds about 13).
@@ -147,21 +168,22 @@ constexpr int kMinPlaneCells = 6;
 void fitPlanes(Target& t, const std::vector<int64_t>& needed, int threads) {
   std::vector<size_t> todo;
   for (int64_t j : needed)
-    if (j >= 0 && !t.fitted[static_cast<size_t>(j)]) {
-      t.fitted[static_cast<size_t>(j)] = 1;
+    if (j >= 0 && t.plane_of[static_cast<size_t>(j)] == 0) {
       todo.push_back(static_cast<size_t>(j));
+      t.plane_of[static_cast<size_t>(j)] = static_cast<uint32_t>(t.planes.size() + todo.size());
     }
+  t.planes.resize(t.planes.size() + todo.size());
   const std::vector<Offset> near = offsetsWithin(t.normal_radius);
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (size_t n = 0; n < todo.size(); ++n) {
     const size_t i = todo[n];
-    const LatticeCell& c = t.cells[i];
+    const LatticeCell c = t.cells.at(i);
     // In lattice units (the cells are cubes): the offsets are exact integers.
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
     int count = 0;
     for (const Offset& o : near) {
-      if (t.index.find(c.u + o.du, c.v + o.dv, c.k + o.dk) < 0) continue;
+      if (t.cells.find(c.u + o.du, c.v + o.dv, c.k + o.dk) < 0) continue;
       const Eigen::Vector3d d(o.du, o.dv, o.dk);
       sum += d;
       outer += d * d.transpose();
@@ -173,8 +195,9 @@ void fitPlanes(Target& t, const std::vector<int64_t>& needed, int threads) {
     eig.computeDirect(outer / count - mean * mean.transpose());
     const Eigen::Vector3d l = eig.eigenvalues();  // ascending
     if (!(l(0) <= t.planarity * l(1))) continue;  // a corner, an edge, clutter: no one normal
-    t.planes[i].point = centreOf(t.grid, c) + t.grid.cell * mean;
-    t.planes[i].normal = eig.eigenvectors().col(0).normalized();
+    Plane& plane = t.planes[t.plane_of[i] - 1];
+    plane.point = centreOf(t.grid, c) + t.grid.cell * mean;
+    plane.normal = eig.eigenvectors().col(0).normalized();
   }
 }
 
@@ -195,7 +218,7 @@ int64_t nearestCell(const Target& t, const Eigen::Vector3d& f, double radius) {
   int64_t found = -1;
   for (const Offset& o : t.search) {
     if (o.length - slack > best) break;
-    const int64_t i = t.index.find(u + o.du, v + o.dv, k + o.dk);
+    const int64_t i = t.cells.find(u + o.du, v + o.dv, k + o.dk);
     if (i < 0) continue;
     const double d = (Eigen::Vector3d(o.du, o.dv, o.dk) - off).norm();
     if (d < best || (found < 0 && d <= best)) {
@@ -260,13 +283,12 @@ Sweep sweep(Target& t, const std::vector<Eigen::Vector3d>& source, const Eigen::
     for (size_t i = c * per_chunk; i < std::min(source.size(), (c + 1) * per_chunk); ++i) {
       const Eigen::Vector3d p = R * source[i] + shift;
       const Eigen::Vector3d f = latticeOf(t.grid, p);
-      const bool seen =
-          std::abs(f.x()) < 1e9 && std::abs(f.y()) < 1e9 &&
-          t.columns.find(static_cast<int>(std::lround(f.x())), static_cast<int>(std::lround(f.y())), 0) >= 0;
+      const bool seen = std::abs(f.x()) < 1e9 && std::abs(f.y()) < 1e9 &&
+                        t.columns.has(static_cast<int>(std::lround(f.x())), static_cast<int>(std::lround(f.y())));
       s.seen += seen;
       const int64_t j = nearest[i];
       if (j < 0) continue;
-      const Plane& plane = t.planes[static_cast<size_t>(j)];
+      const Plane& plane = t.planes[t.plane_of[static_cast<size_t>(j)] - 1];
       if (plane.normal.isZero()) continue;
       s.seen_inliers += seen;
       const double r = plane.normal.dot(p - plane.point);
@@ -321,15 +343,13 @@ SixDofFinish finishSixDof(const SliceStack& target, const SliceStack& source, co
   for (const LatticeCell& c : latticeCells(source, stride)) points.push_back(centreOf(source.grid, c));
   result.points = points.size();
 
-  const std::vector<LatticeCell> cells = latticeCells(target);
   Target t{target.grid,
            target.size(),
-           cells,
-           LatticeIndex(target.grid, target.size(), cells),
-           LatticeIndex(target.grid, 1, columnsOf(cells)),
+           CellLookup(target),
+           SeenColumns(target),
            offsetsWithin(widest + std::sqrt(3.0) / 2),
-           std::vector<Plane>(cells.size()),
-           std::vector<uint8_t>(cells.size(), 0),
+           {},
+           std::vector<uint32_t>(target_cells, 0),
            params.normal_radius_cells,
            params.planarity};
 
