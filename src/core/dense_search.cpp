@@ -24,6 +24,8 @@ double DensePose::score() const {
   return static_cast<double>(telling_inliers) - kContradictionWeight * static_cast<double>(contradicted);
 }
 
+// Named, not anonymous: PoseLander (dense_search.hpp) holds a PoseJudge, and a
+// type a header names may not hold members of an anonymous namespace's types.
 namespace dense_detail {
 
 int coarsening(const SliceStack& s, int side) {
@@ -706,7 +708,10 @@ DenseSearch searchDensely(const PoseLander& land, const ConsensusParams& same, c
 
   // Full grid: the best fine offset within the coarse one, then ICP on occupancy.
   std::vector<DensePose> refined(coarse.size());
-  const BitColumns& columns = *land.columns_;  // the search reaches no farther than the lander's columns
+  // The lander's columns where it made them (every map the wide search reaches).
+  std::optional<BitColumns> own;
+  if (!land.columns_) own.emplace(columnsOf(judge.dilated, tg));
+  const BitColumns& columns = land.columns_ ? *land.columns_ : *own;
   const OccupancyRefiner& refine = land.refiner();
   DenseRefineParams refine_params;
   refine_params.max_cells = params.refine_cells;

@@ -160,8 +160,8 @@ class PoseLander {
                                    const DenseSearchParams& params);
   std::shared_ptr<const dense_detail::PoseJudge> judge_;
   std::shared_ptr<const OccupancyRefiner> refine_;
-  std::shared_ptr<const BitColumns>
-      columns_;  ///< down the target's columns; null on maps the wide search does not reach
+  /// The target's dilated slices down its columns; null on maps the wide search does not reach.
+  std::shared_ptr<const BitColumns> columns_;
   int threads_ = 1;
 };
 
