@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <tuple>
 
 #include "dense_refine.hpp"
@@ -116,12 +117,19 @@ CandidateVerdict decide(MatchResult& r, const FeatureProposals& f, const std::op
     if (2 * target.grid <= kBars.coarsest_pooled_cell + 1e-9)
       at_pooled = searchAt(target, source, pooled(*ft), pooled(*fs), 2, params);
   }
-  // The maps' occupancy prepared once for the wide search and the candidates.
-  DenseSearchParams dp;
-  dp.threads = matchThreads(params);
-  const PoseLander land(target.occupancy, source.occupancy, dp);
+  // The maps' occupancy prepared once, where something lands poses on it:
+  // for the wide search and the candidates.
+  std::optional<PoseLander> prepared;
+  const auto land = [&]() -> const PoseLander& {
+    if (!prepared) {
+      DenseSearchParams dp;
+      dp.threads = matchThreads(params);
+      prepared.emplace(target.occupancy, source.occupancy, dp);
+    }
+    return *prepared;
+  };
   if (denseSearchable(target.occupancy, wideSearch()) && denseSearchable(source.occupancy, wideSearch()))
-    wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch(), &land);
+    wide = searchAt(target, source, target.occupancy, source.occupancy, 1, params, wideSearch(), &land());
   DecisionEvidence e;
   e.grid = target.grid;
   e.source_centre = source.occupancy.grid.centre();
@@ -136,7 +144,7 @@ CandidateVerdict decide(MatchResult& r, const FeatureProposals& f, const std::op
     e.searches.push_back({from, evidenceOf(**o), (*o)->pooling, {}});
     *lead = e.searches.back().found.lead();
   }
-  e.candidates = refineAndLand(land, target, source, proposals, params, f.votes);
+  if (!proposals.empty()) e.candidates = refineAndLand(land(), target, source, proposals, params, f.votes);
   CandidateVerdict v;
   // The decision asks for the second look of a search on the maps' own
   // cells (at the grid, pooled: those ran on the full slices), one at a time.

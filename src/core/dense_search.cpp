@@ -9,6 +9,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <tuple>
@@ -494,7 +495,7 @@ std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, cons
 
 PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params)
     : judge_(std::make_shared<const PoseJudge>(target, source, params)),
-      refine_(std::make_shared<const OccupancyRefiner>(target, source)),
+      refine_(std::make_shared<Refiner>()),
       threads_(std::max(1, params.threads)) {
   // On maps a dense search reaches (the wide one's bound: BitColumns take a
   // word a pixel per 64 slices, at most a few MB there) a pose's height is
@@ -538,7 +539,15 @@ int PoseLander::heightOffset(const Rigid2D& T, int middle, int reach) const {
   return mostInliersNear(SliceWindows{judge_->dilated}, judge_->source_cells, judge_->target.grid, T, middle, reach);
 }
 
-const OccupancyRefiner& PoseLander::refiner() const { return *refine_; }
+struct PoseLander::Refiner {
+  std::once_flag made;
+  std::optional<OccupancyRefiner> refiner;
+};
+
+const OccupancyRefiner& PoseLander::refiner() const {
+  std::call_once(refine_->made, [this] { refine_->refiner.emplace(judge_->target, judge_->source); });
+  return *refine_->refiner;
+}
 
 DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset) { return land({{T, offset}}).front(); }
 

@@ -159,7 +159,8 @@ class PoseLander {
   friend DenseSearch searchDensely(const PoseLander& land, const ConsensusParams& same, const Eigen::Vector2d& pivot,
                                    const DenseSearchParams& params);
   std::shared_ptr<const dense_detail::PoseJudge> judge_;
-  std::shared_ptr<const OccupancyRefiner> refine_;
+  struct Refiner;  ///< made when first asked for: a landing alone needs none
+  std::shared_ptr<Refiner> refine_;
   /// The target's dilated slices down its columns; null on maps the wide search does not reach.
   std::shared_ptr<const BitColumns> columns_;
   int threads_ = 1;

@@ -17,7 +17,7 @@ struct LatticeCell {
 };
 
 /// The occupied cells of a stack in slice order, thinned to every `stride`-th.
-std::vector<LatticeCell> latticeCells(const SliceStack& s, size_t stride = 1) {
+std::vector<LatticeCell> latticeCells(const SliceStack& s, size_t stride) {
   std::vector<LatticeCell> out;
   const auto w = static_cast<uint32_t>(s.grid.width);
   size_t n = 0;
@@ -45,40 +45,55 @@ Eigen::Vector3d latticeOf(const SliceGrid& g, const Eigen::Vector3d& p) {
 
 /// The occupied cells of a stack, found by lattice position. A slice's cells
 /// are sorted by pixel index (SliceStack), so one row's cells are one short
-/// run of them: a table of where each row's run starts leaves a search of a
-/// few cells. It is built in one pass and a few hundred kB over the stack's
-/// own cells; a hash of every cell (24 MB of table) took 0.1 s of a room
-/// pair's 0.35 s before its first sweep at 0.05 m cells, most of it page faults.
+/// run of them: a table of where each row's run starts, over the rows the
+/// slice spans, leaves a search of a few cells. A slice spanning many more
+/// rows than it has cells (a peer may send a few cells on the largest
+/// raster) is searched whole instead, so that the tables hold at most a few
+/// entries per cell. Built in one pass over the stack's own cells; a hash of
+/// every cell (24 MB of table) took 0.1 s of a room pair's 0.35 s before its
+/// first sweep at 0.05 m cells, most of it page faults.
 class CellLookup {
  public:
   explicit CellLookup(const SliceStack& s)
-      : stack_(s), rows_(static_cast<size_t>(s.grid.height) + 1), first_(static_cast<size_t>(s.size()) + 1, 0) {
-    starts_.resize(static_cast<size_t>(s.size()) * rows_);
+      : stack_(s), first_(static_cast<size_t>(s.size()) + 1, 0), slices_(static_cast<size_t>(s.size())) {
     const auto w = static_cast<uint32_t>(s.grid.width);
     for (size_t k = 0; k < s.cells.size(); ++k) {
       const std::vector<uint32_t>& cells = s.cells[k];
       first_[k + 1] = first_[k] + cells.size();
-      uint32_t* start = starts_.data() + k * rows_;
+      if (cells.empty()) continue;
+      Rows& r = slices_[k];
+      r.first = cells.front() / w;
+      const size_t span = cells.back() / w - r.first + 1;
+      if (span > kMostRowsPerCell * cells.size()) continue;  // searched whole
+      r.count = span;
+      r.start = starts_.size();
       size_t n = 0;
-      for (size_t v = 0; v < rows_; ++v) {
+      for (size_t v = r.first; v <= r.first + span; ++v) {  // one past the last row too
         while (n < cells.size() && cells[n] / w < v) ++n;
-        start[v] = static_cast<uint32_t>(n);
+        starts_.push_back(static_cast<uint32_t>(n));
       }
+      r.tabled = true;
     }
   }
-  /// Every cell's index: its place among all of the stack's cells, slice by slice.
-  size_t size() const { return first_.back(); }
-  /// Index of the occupied cell at (u, v, k), or -1.
+  /// Index of the occupied cell at (u, v, k), or -1: its place among all of
+  /// the stack's cells, slice by slice.
   int64_t find(int u, int v, int k) const {
     const SliceGrid& g = stack_.grid;
     if (u < 0 || v < 0 || k < 0 || u >= g.width || v >= g.height || k >= stack_.size()) return -1;
     const std::vector<uint32_t>& cells = stack_.cells[static_cast<size_t>(k)];
-    const uint32_t* start = starts_.data() + static_cast<size_t>(k) * rows_ + static_cast<size_t>(v);
-    const auto begin = cells.begin() + start[0], end = cells.begin() + start[1];
+    const Rows& r = slices_[static_cast<size_t>(k)];
+    auto begin = cells.begin(), end = cells.end();
+    if (r.tabled) {
+      const auto row = static_cast<size_t>(v);
+      if (row < r.first || row >= r.first + r.count) return -1;  // no cell of the slice on that row
+      const size_t at = r.start + (row - r.first);
+      begin = cells.begin() + starts_[at];
+      end = cells.begin() + starts_[at + 1];
+    }
     const auto key = static_cast<uint32_t>(v) * static_cast<uint32_t>(g.width) + static_cast<uint32_t>(u);
-    const auto at = std::lower_bound(begin, end, key);
-    if (at == end || *at != key) return -1;
-    return static_cast<int64_t>(first_[static_cast<size_t>(k)] + static_cast<size_t>(at - cells.begin()));
+    const auto found = std::lower_bound(begin, end, key);
+    if (found == end || *found != key) return -1;
+    return static_cast<int64_t>(first_[static_cast<size_t>(k)] + static_cast<size_t>(found - cells.begin()));
   }
   /// The lattice position of cell `index`.
   LatticeCell at(size_t index) const {
@@ -89,10 +104,19 @@ class CellLookup {
   }
 
  private:
+  /// A table's rows per cell at most: rooms and streets span a few rows per
+  /// cell of a slice, a stray few cells on a large raster thousands.
+  static constexpr size_t kMostRowsPerCell = 4;
+  /// Where one slice's rows start: rows first .. first + count - 1 at
+  /// starts_[start .. start + count] (one past the last row too).
+  struct Rows {
+    size_t first = 0, count = 0, start = 0;
+    bool tabled = false;
+  };
   const SliceStack& stack_;
-  size_t rows_;                   ///< the raster's rows, and one past the last
-  std::vector<size_t> first_;     ///< per slice, the index of its first cell (and one past the last slice's)
-  std::vector<uint32_t> starts_;  ///< per slice, per row (and one past), where the row's cells start in the slice
+  std::vector<size_t> first_;  ///< per slice, the index of its first cell (and one past the last slice's)
+  std::vector<Rows> slices_;
+  std::vector<uint32_t> starts_;  ///< every tabled slice's row starts, in its cells
 };
 
 /// Where a stack saw anything: the columns (u, v) with a cell in some slice.
@@ -150,9 +174,8 @@ struct Target {
   SeenColumns columns;  ///< where the target saw anything
   /// Steps out to the widest radius plus the half diagonal a position may sit off its cell.
   std::vector<Offset> search;
-  /// The planes fitted so far, each where a correspondence first needed it:
-  /// a map of 600,000 cells at 0.05 m needs a few tens of thousands, and a
-  /// plane for every cell (28 MB) took longer to allocate than a sweep.
+  /// The planes fitted so far (fitPlanes): a slot for every cell, 28 MB on
+  /// a room of 600,000 cells at 0.05 m, took longer to allocate than a sweep.
   std::vector<Plane> planes;
   std::vector<uint32_t> plane_of;           ///< per cell, 1 + its plane's index in `planes`, 0 where none is fitted yet
   double normal_radius = 0, planarity = 0;  ///< SixDofFinishParams' [cells], [ratio]

@@ -113,6 +113,31 @@ TEST(DenseSearch, LeavesLargeAndIncompleteMapsAlone) {
   EXPECT_FALSE(denseSearchable(SliceStack{}));
 }
 
+// A search on a lander prepared once for other work too (the candidates'
+// landings) finds what a search on the two maps alone finds, pose for pose,
+// with the wide search's coarser raster as well as the default one.
+TEST(DenseSearch, ASearchOnALanderFindsWhatOneOnTheMapsFinds) {
+  const Points room = roomScan();
+  const Pose4 moved{1.2, 0.8, 0.2, radians(64)};
+  const SliceStack t = stackOf(room), s = stackOf(transformPoints(room, Pose4::fromMatrix(moved.matrix().inverse())));
+  DenseSearchParams wide;
+  wide.coarse_side = kWideCoarseSide;
+  wide.min_coarsening = kWideMinCoarsening;
+  const PoseLander land(t, s);
+  for (const DenseSearchParams& params : {DenseSearchParams{}, wide}) {
+    const DenseSearch alone = searchDensely(t, s, kSame, s.grid.centre(), params),
+                      shared = searchDensely(land, kSame, s.grid.centre(), params);
+    ASSERT_TRUE(alone.searched);
+    ASSERT_EQ(shared.poses.size(), alone.poses.size());
+    for (size_t i = 0; i < alone.poses.size(); ++i) {
+      EXPECT_EQ(shared.poses[i].transform.yaw, alone.poses[i].transform.yaw);
+      EXPECT_EQ(shared.poses[i].transform.t, alone.poses[i].transform.t);
+      EXPECT_EQ(shared.poses[i].offset, alone.poses[i].offset);
+      EXPECT_EQ(shared.poses[i].score(), alone.poses[i].score());
+    }
+  }
+}
+
 // A pose found otherwise (the features' answer) is judged as the search judges
 // its own: landing the search's poses again gives their very tally, and the
 // half turn of a room on itself contradicts what the room saw empty.
