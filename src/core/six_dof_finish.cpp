@@ -72,7 +72,6 @@ class CellLookup {
         while (n < cells.size() && cells[n] / w < v) ++n;
         starts_.push_back(static_cast<uint32_t>(n));
       }
-      r.tabled = true;
     }
   }
   /// Index of the occupied cell at (u, v, k), or -1: its place among all of
@@ -83,7 +82,7 @@ class CellLookup {
     const std::vector<uint32_t>& cells = stack_.cells[static_cast<size_t>(k)];
     const Rows& r = slices_[static_cast<size_t>(k)];
     auto begin = cells.begin(), end = cells.end();
-    if (r.tabled) {
+    if (r.count > 0) {
       const auto row = static_cast<size_t>(v);
       if (row < r.first || row >= r.first + r.count) return -1;  // no cell of the slice on that row
       const size_t at = r.start + (row - r.first);
@@ -108,10 +107,10 @@ class CellLookup {
   /// cell of a slice, a stray few cells on a large raster thousands.
   static constexpr size_t kMostRowsPerCell = 4;
   /// Where one slice's rows start: rows first .. first + count - 1 at
-  /// starts_[start .. start + count] (one past the last row too).
+  /// starts_[start .. start + count] (one past the last row too); no rows
+  /// (count 0) where the slice is searched whole or has no cells.
   struct Rows {
     size_t first = 0, count = 0, start = 0;
-    bool tabled = false;
   };
   const SliceStack& stack_;
   std::vector<size_t> first_;  ///< per slice, the index of its first cell (and one past the last slice's)
