@@ -20,6 +20,9 @@ echo "== generating a two-floor building seen by three robots (seed 7, low noise
 echo "== creating the fleet's keys (a CA, a certificate per robot, signed DDS Security documents)"
 "$build/src/cli/tomomap" fleet-keys --agents alpha,bravo,charlie --out "$out/keys" >/dev/null
 
+# Three daemons on one machine's cores: their OpenMP threads sleep while they
+# wait, as the service's do (docs/operations.md, "Sharing the CPU").
+export OMP_WAIT_POLICY=passive
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; }
 trap cleanup EXIT
