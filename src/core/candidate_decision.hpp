@@ -120,6 +120,10 @@ struct SearchLead {
   DenseEvidence found;  ///< its best pose, as it found it, and its next's score
   int pooling = 1;      ///< the maps' slices per slice it searched: its height is that coarse
   std::optional<SecondLook> look;
+  /// It judged its poses on the occupancy the candidates are landed on (the
+  /// wide search): its next is then also every candidate elsewhere
+  /// (decideOnCandidates).
+  bool judged_as_candidates = false;
 };
 
 const char* onName(CandidateVerdict::On on);
@@ -155,6 +159,8 @@ struct DecisionEvidence {
 /// so, and that search's second look finds it again (asked for by
 /// needs_look). At the place the first three answer, the pose answered is
 /// the candidate there that lands the most on the maps' own cells, unpooled.
+/// A search's next is its own next pose; for one judged_as_candidates, the
+/// best of that and every candidate not at its best pose's place.
 CandidateVerdict decideOnCandidates(const DecisionEvidence& e, const MatchParams& params);
 
 }  // namespace tomomap

@@ -141,7 +141,7 @@ CandidateVerdict decide(MatchResult& r, const FeatureProposals& f, const std::op
       proposals.push_back(
           {from, static_cast<int>(i), 0, (*o)->search.poses[i].transform, (*o)->search.poses[i].offset});
     if (!(*o)->found()) continue;
-    e.searches.push_back({from, evidenceOf(**o), (*o)->pooling, {}});
+    e.searches.push_back({from, evidenceOf(**o), (*o)->pooling, {}, from == Candidate::From::search_wide});
     *lead = e.searches.back().found.lead();
   }
   if (!proposals.empty()) e.candidates = refineAndLand(land(), target, source, proposals, params, f.votes);

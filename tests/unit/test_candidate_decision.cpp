@@ -96,7 +96,8 @@ TEST(CandidateDecision, AVotesLeadCountsByItsSlicesNotByHowAlikeTheyAre) {
 namespace {
 
 /// A dense search's word on its own best pose at (x, y, yaw): `best` telling
-/// cells landed over 6 slices, its next pose `next`.
+/// cells landed over 6 slices, its next pose `next`. The wide search judges
+/// its poses on the occupancy the candidates are landed on, as in a match.
 SearchLead searchLead(Candidate::From from, double x, double y, double yaw, size_t best, double next,
                       std::optional<SecondLook> look = {}) {
   SearchLead s;
@@ -107,6 +108,7 @@ SearchLead searchLead(Candidate::From from, double x, double y, double yaw, size
   s.found.best.support = s.found.best.support_seen = 6;
   s.found.next_score = next;
   s.look = look;
+  s.judged_as_candidates = from == Candidate::From::search_wide;
   return s;
 }
 
@@ -122,6 +124,12 @@ Candidate as(Candidate c, Candidate::From from, int rank = 0, std::vector<int> v
 Candidate pooledAs(Candidate fine, const Candidate& pooled) {
   fine.pooled_slices = pooled.slices;
   return fine;
+}
+
+/// `c` landed with `telling` telling cells, as the search whose poses are judged so would score it.
+Candidate scoring(Candidate c, size_t telling) {
+  c.landed.telling_inliers = telling;
+  return c;
 }
 
 /// `c` landing `contradicted` telling cells in the target's empty space per 1,000 on its occupancy.
@@ -218,7 +226,16 @@ std::vector<Row> truthTable() {
        0.1,
        -1,
        On::occupancy,
-       "search_wide's best pose is at its place but within chance of its next (1.04x, 0.7 sigma)"},
+       "search_wide's best pose is at its place but within chance of its next or a candidate elsewhere (1.04x, "
+       "0.7 sigma)"},
+      {"the search's best ahead of its own next, not of a candidate elsewhere judged as it judges its poses",
+       {as(right(), From::search_wide, 0, one_vote), scoring(as(along(), From::features), 560)},
+       {wideAtRight()},
+       0.1,
+       -1,
+       On::occupancy,
+       "search_wide's best pose is at its place but within chance of its next or a candidate elsewhere (1.07x, "
+       "1.2 sigma)"},
       {"24 % of its telling cells in the target's empty space (at most 20 %)",
        {contradicting(as(right(), From::search_wide, 0, one_vote), 240), as(along(), From::search_pooled)},
        {wideAtRight()},
