@@ -6,7 +6,7 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake pkg-config
-  libpcl-dev libopenmpi-dev libeigen3-dev libopencv-dev liboctomap-dev libceres-dev
+  libpcl-dev libopenmpi-dev libeigen3-dev libopencv-dev liboctomap-dev libceres-dev libfftw3-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   cyclonedds-dev cyclonedds-tools  # the tests' ROS 2 node: a second DDS vendor, rmw_cyclonedds's
   libtomlplusplus-dev libcli11-dev nlohmann-json3-dev

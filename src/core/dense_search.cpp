@@ -152,21 +152,6 @@ class Enclosure {
   std::vector<uint16_t> slices_;
 };
 
-/// The packed real spectrum (OpenCV's CCS) of a coarse binary `image`
-/// zero-padded to `padded`, into `out`; `out` empty for an empty image. `big`
-/// is scratch of the padded size: kept from call to call, it spares an
-/// allocation (and its page faults) per image and yaw step.
-void spectrumOf(const cv::Mat& image, cv::Size padded, cv::Mat& big, cv::Mat& out) {
-  if (cv::countNonZero(image) == 0) {
-    out.release();
-    return;
-  }
-  big.create(padded, CV_32F);
-  big.setTo(0);
-  image.copyTo(big(cv::Rect(0, 0, image.cols, image.rows)));
-  cv::dft(big, out, 0, image.rows);  // the rows below the image are zero: their transforms are skipped
-}
-
 /// The best shift at one (yaw, coarse height offset).
 struct Peak {
   double score = 0;
@@ -595,18 +580,26 @@ DenseSearch searchDensely(const PoseLander& land, const ConsensusParams& same, c
   const Eigen::Vector2d centre = sg.centre();
   const double radius = 0.5 * sg.cell * std::hypot(sg.width, sg.height) + sg.cell;
   const int xs = static_cast<int>(std::ceil(2.0 * radius / C)) + 1, zs = (source.size() + c - 1) / c;
-  const cv::Size padded(cv::getOptimalDFTSize(xt + xs - 1), cv::getOptimalDFTSize(yt + xs - 1));
+  // Zero-padded so that no shift wraps around.
+  const RealFft fft(RealFft::fastSize(yt + xs - 1), RealFft::fastSize(xt + xs - 1));
+  const auto pixel = [&fft](int u, int v) {
+    return static_cast<size_t>(v) * static_cast<size_t>(fft.cols()) + static_cast<size_t>(u);
+  };
 
-  std::vector<cv::Mat> timg(static_cast<size_t>(zt));
-  for (auto& m : timg) m = cv::Mat::zeros(yt, xt, CV_32F);
-  const auto tw = static_cast<uint32_t>(tg.width);
-  for (int k = 0; k < target.size(); ++k)
-    for (uint32_t idx : target.cells[static_cast<size_t>(k)])
-      timg[static_cast<size_t>(k / c)].at<float>(static_cast<int>(idx / tw) / c, static_cast<int>(idx % tw) / c) = 1.f;
-  std::vector<cv::Mat> tspec(timg.size());
+  std::vector<Spectrum> tspec(static_cast<size_t>(zt));
+  std::vector<int> target_occupied(tspec.size());  // coarse cells per slice: what bounds each offset's peak
   {
-    cv::Mat big;
-    for (size_t k = 0; k < timg.size(); ++k) spectrumOf(timg[k], padded, big, tspec[k]);
+    std::vector<RealImage> timg(tspec.size(), RealImage(fft.imageSize(), 0.f));
+    const auto tw = static_cast<uint32_t>(tg.width);
+    for (int k = 0; k < target.size(); ++k)
+      for (uint32_t idx : target.cells[static_cast<size_t>(k)]) {
+        float& at =
+            timg[static_cast<size_t>(k / c)][pixel(static_cast<int>(idx % tw) / c, static_cast<int>(idx / tw) / c)];
+        target_occupied[static_cast<size_t>(k / c)] += at == 0.f;
+        at = 1.f;
+      }
+    for (size_t k = 0; k < timg.size(); ++k)
+      if (target_occupied[k] > 0) fft.forward(timg[k], tspec[k]);
   }
 
   // The source's cells as the coarse raster sees them: one per pixel per
@@ -623,8 +616,6 @@ DenseSearch searchDensely(const PoseLander& land, const ConsensusParams& same, c
   }
   const int steps = std::max(1, static_cast<int>(std::lround(2.0 * kPi / params.yaw_step)));
   const size_t offsets = static_cast<size_t>(zs + zt - 1);
-  std::vector<int> target_occupied(timg.size());  // coarse cells per slice: what bounds each offset's peak
-  for (size_t k = 0; k < timg.size(); ++k) target_occupied[k] = cv::countNonZero(timg[k]);
   // Each (yaw step, height offset)'s peak, once correlated.
   std::vector<std::vector<std::optional<Peak>>> peaks(static_cast<size_t>(steps),
                                                       std::vector<std::optional<Peak>>(offsets));
@@ -633,37 +624,49 @@ DenseSearch searchDensely(const PoseLander& land, const ConsensusParams& same, c
 #pragma omp parallel num_threads(std::max(1, params.threads))
     {
       // Each thread's images and spectra, reused from yaw step to yaw step.
-      std::vector<cv::Mat> simg(static_cast<size_t>(zs)), sspec(static_cast<size_t>(zs));
-      for (auto& m : simg) m.create(xs, xs, CV_32F);
-      cv::Mat big, corr;
-      std::vector<cv::Mat> sums;  // per height offset
+      std::vector<RealImage> simg(static_cast<size_t>(zs), RealImage(fft.imageSize(), 0.f));
+      std::vector<Spectrum> sspec(simg.size()), sums;  // sums: per height offset
+      RealImage corr;
       std::vector<char> summed;
+      std::vector<int> source_occupied(simg.size());
+      std::vector<size_t> set;  // the pixels set, to be cleared again
 #pragma omp for schedule(dynamic)
       for (size_t n = 0; n < todo.size(); ++n) {
         const int step = todo[n];
         const double yaw = 2.0 * kPi * step / steps, cs = std::cos(yaw), sn = std::sin(yaw);
-        for (auto& m : simg) m.setTo(0);
+        std::fill(source_occupied.begin(), source_occupied.end(), 0);
         for (const auto& [d, z] : coarse_cells) {
           const int u = static_cast<int>((cs * d.x() - sn * d.y() + radius) / C);
           const int v = static_cast<int>((sn * d.x() + cs * d.y() + radius) / C);
-          simg[static_cast<size_t>(z)].at<float>(v, u) = 1.f;
+          float& at = simg[static_cast<size_t>(z)][pixel(u, v)];
+          if (at != 0.f) continue;
+          at = 1.f;
+          ++source_occupied[static_cast<size_t>(z)];
+          set.push_back(static_cast<size_t>(z) * fft.imageSize() + pixel(u, v));
         }
-        std::vector<int> source_occupied(simg.size());
-        for (size_t k = 0; k < simg.size(); ++k) source_occupied[k] = cv::countNonZero(simg[k]);
         const std::vector<char> wanted = offsetsPeakingWithin(target_occupied, source_occupied, from, below);
-        if (std::none_of(wanted.begin(), wanted.end(), [](char w) { return w; })) continue;
-        for (size_t k = 0; k < simg.size(); ++k) spectrumOf(simg[k], padded, big, sspec[k]);
-        correlateStacks(tspec, sspec, sums, summed, wanted);
-        for (int dz = -(zs - 1); dz <= zt - 1; ++dz) {
-          const size_t at = static_cast<size_t>(dz + zs - 1);
-          if (!summed[at]) continue;
-          cv::dft(sums[at], corr, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
-          double best = 0;
-          cv::Point top;
-          cv::minMaxLoc(corr, nullptr, &best, nullptr, &top);
-          const int dx = top.x < xt ? top.x : top.x - padded.width, dy = top.y < yt ? top.y : top.y - padded.height;
-          peaks[static_cast<size_t>(step)][at] = Peak{best, step, dz, dx, dy};
+        if (std::any_of(wanted.begin(), wanted.end(), [](char w) { return w; })) {
+          for (size_t k = 0; k < simg.size(); ++k)
+            if (source_occupied[k] > 0)
+              fft.forward(simg[k], sspec[k]);
+            else
+              sspec[k].clear();
+          correlateStacks(tspec, sspec, fft.cols() / 2 + 1, sums, summed, wanted);
+          // The transforms leave the scale: a pixel's value is the coincident cells times this.
+          const double scale = 1.0 / static_cast<double>(fft.imageSize());
+          for (int dz = -(zs - 1); dz <= zt - 1; ++dz) {
+            const size_t at = static_cast<size_t>(dz + zs - 1);
+            if (!summed[at]) continue;
+            fft.inverse(sums[at], corr);
+            const size_t top = static_cast<size_t>(std::max_element(corr.begin(), corr.end()) - corr.begin());
+            const int x = static_cast<int>(top % static_cast<size_t>(fft.cols())),
+                      y = static_cast<int>(top / static_cast<size_t>(fft.cols()));
+            const int dx = x < xt ? x : x - fft.cols(), dy = y < yt ? y : y - fft.rows();
+            peaks[static_cast<size_t>(step)][at] = Peak{scale * corr[top], step, dz, dx, dy};
+          }
         }
+        for (size_t i : set) simg[i / fft.imageSize()][i % fft.imageSize()] = 0.f;
+        set.clear();
       }
     }
   };

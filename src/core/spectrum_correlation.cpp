@@ -1,6 +1,11 @@
 #include "spectrum_correlation.hpp"
 
+#include <fftw3.h>
+
 #include <algorithm>
+#include <map>
+#include <mutex>
+#include <stdexcept>
 #include <utility>
 
 namespace tomomap {
@@ -11,20 +16,6 @@ namespace {
 inline void addConjugateProduct(float ar, float ai, float br, float bi, float& re, float& im) {
   re += ar * br + ai * bi;
   im += ai * br - ar * bi;
-}
-
-/// In CCS, the first column (and the last, where the width is even) holds
-/// the transform of a real column: its first element real, then (re, im)
-/// pairs down the rows, then one more real where the height is even. Every
-/// other column pair (2j-1, 2j) is (re, im) on each row.
-void addColumn(const cv::Mat& a, const cv::Mat& b, cv::Mat& c, int col) {
-  const int rows = a.rows;
-  c.at<float>(0, col) += a.at<float>(0, col) * b.at<float>(0, col);
-  int r = 1;
-  for (; r + 1 < rows; r += 2)
-    addConjugateProduct(a.at<float>(r, col), a.at<float>(r + 1, col), b.at<float>(r, col), b.at<float>(r + 1, col),
-                        c.at<float>(r, col), c.at<float>(r + 1, col));
-  if (r < rows) c.at<float>(r, col) += a.at<float>(r, col) * b.at<float>(r, col);
 }
 
 /// Calls f(za, zb) for the slice pairs of offset dz: a[z + dz] with b[z],
@@ -51,16 +42,74 @@ std::vector<char> offsetsPeakingWithin(const std::vector<int>& a_cells, const st
   return out;
 }
 
-void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& b, std::vector<cv::Mat>& out,
-                     std::vector<char>& any, const std::vector<char>& wanted) {
+void* fftwAllocate(size_t bytes) {
+  void* p = fftwf_malloc(std::max<size_t>(bytes, 1));
+  if (!p) throw std::bad_alloc();
+  return p;
+}
+
+void fftwFree(void* p) noexcept { fftwf_free(p); }
+
+struct RealFft::Plans {
+  fftwf_plan forward = nullptr, inverse = nullptr;
+};
+
+RealFft::RealFft(int rows, int cols) : rows_(rows), cols_(cols) {
+  if (rows < 1 || cols < 1) throw std::invalid_argument("RealFft: an empty size");
+  // One plan per size for the process: planning (with FFTW_ESTIMATE, which
+  // looks at no data) takes milliseconds, a search runs thousands of transforms.
+  static std::mutex planner;
+  static std::map<std::pair<int, int>, std::shared_ptr<const Plans>> made;
+  const std::lock_guard<std::mutex> lock(planner);
+  std::shared_ptr<const Plans>& plans = made[{rows, cols}];
+  if (!plans) {
+    RealImage image(imageSize());
+    Spectrum spectrum(spectrumSize());
+    auto* complex = reinterpret_cast<fftwf_complex*>(spectrum.data());
+    auto p = std::make_shared<Plans>();
+    p->forward = fftwf_plan_dft_r2c_2d(rows, cols, image.data(), complex, FFTW_ESTIMATE);
+    p->inverse = fftwf_plan_dft_c2r_2d(rows, cols, complex, image.data(), FFTW_ESTIMATE);
+    if (!p->forward || !p->inverse) throw std::runtime_error("FFTW could not plan a transform");
+    plans = std::move(p);
+  }
+  plans_ = plans;
+}
+
+void RealFft::forward(const RealImage& image, Spectrum& out) const {
+  if (image.size() != imageSize()) throw std::invalid_argument("RealFft::forward: an image of another size");
+  out.resize(spectrumSize());
+  // FFTW's r2c leaves its input as it was (it is const here for that).
+  fftwf_execute_dft_r2c(plans_->forward, const_cast<float*>(image.data()),
+                        reinterpret_cast<fftwf_complex*>(out.data()));
+}
+
+void RealFft::inverse(Spectrum& spectrum, RealImage& out) const {
+  if (spectrum.size() != spectrumSize()) throw std::invalid_argument("RealFft::inverse: a spectrum of another size");
+  out.resize(imageSize());
+  fftwf_execute_dft_c2r(plans_->inverse, reinterpret_cast<fftwf_complex*>(spectrum.data()), out.data());
+}
+
+int RealFft::fastSize(int n) {
+  long best = 2;
+  while (best < n) best *= 2;
+  for (long three = 3; 2 * three < best; three *= 3) {
+    long size = 2 * three;
+    while (size < n) size *= 2;
+    best = std::min(best, size);
+  }
+  return static_cast<int>(best);
+}
+
+void correlateStacks(const std::vector<Spectrum>& a, const std::vector<Spectrum>& b, size_t row,
+                     std::vector<Spectrum>& out, std::vector<char>& any, const std::vector<char>& wanted) {
   const int na = static_cast<int>(a.size()), nb = static_cast<int>(b.size());
   const size_t offsets = static_cast<size_t>(std::max(0, na + nb - 1));
   out.resize(offsets);
   any.assign(offsets, 0);
-  cv::Size size;
-  for (const cv::Mat& m : a)
+  size_t size = 0;
+  for (const Spectrum& m : a)
     if (!m.empty()) size = m.size();
-  if (size.empty()) return;  // every a is an empty image's: no offset has a pair
+  if (size == 0 || row == 0) return;  // every a is an empty image's: no offset has a pair
   // The pairs (z + dz, z) of non-empty spectra, offset by offset.
   std::vector<std::vector<std::pair<int, int>>> pairs(offsets);
   for (int dz = -(nb - 1); dz <= na - 1; ++dz) {
@@ -71,20 +120,17 @@ void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& 
     });
     if (pairs[at].empty()) continue;
     any[at] = 1;
-    out[at].create(size, CV_32F);
-    out[at].setTo(0);
+    out[at].resize(size);
   }
-  const int cols = size.width;
-  // The (re, im) pairs of columns 1, 2 to the last pair's, a row at a time,
-  // laid out as a plane of re and one of im, so that the sums vectorise.
-  const size_t n = static_cast<size_t>(cols % 2 == 0 ? cols - 2 : cols - 1) / 2;
+  // A row at a time, laid out as a plane of re and one of im, so that the sums vectorise.
+  const size_t n = row;
   std::vector<float> a_re(a.size() * n), a_im(a_re.size()), b_re(b.size() * n), b_im(b_re.size());
   std::vector<float> c_re(offsets * n), c_im(c_re.size());
-  const auto split = [n](const cv::Mat& m, int r, float* re, float* im) {
-    const float* row = m.ptr<float>(r);
-    for (size_t i = 0; i < n; ++i) re[i] = row[2 * i + 1], im[i] = row[2 * i + 2];
+  const auto split = [n](const Spectrum& m, size_t r, float* re, float* im) {
+    const std::complex<float>* values = m.data() + r * n;
+    for (size_t i = 0; i < n; ++i) re[i] = values[i].real(), im[i] = values[i].imag();
   };
-  for (int r = 0; r < size.height; ++r) {
+  for (size_t r = 0; r < size / n; ++r) {
     for (size_t k = 0; k < a.size(); ++k)
       if (!a[k].empty()) split(a[k], r, a_re.data() + k * n, a_im.data() + k * n);
     for (size_t k = 0; k < b.size(); ++k)
@@ -102,16 +148,8 @@ void correlateStacks(const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& 
         const float* __restrict yi = b_im.data() + static_cast<size_t>(ib) * n;
         for (size_t i = 0; i < n; ++i) addConjugateProduct(xr[i], xi[i], yr[i], yi[i], re[i], im[i]);
       }
-      float* row = out[at].ptr<float>(r);
-      for (size_t i = 0; i < n; ++i) row[2 * i + 1] = re[i], row[2 * i + 2] = im[i];
-    }
-  }
-  for (size_t at = 0; at < offsets; ++at) {
-    if (!any[at]) continue;
-    for (const auto& [ia, ib] : pairs[at]) {
-      addColumn(a[static_cast<size_t>(ia)], b[static_cast<size_t>(ib)], out[at], 0);
-      if (cols % 2 == 0 && cols > 1)
-        addColumn(a[static_cast<size_t>(ia)], b[static_cast<size_t>(ib)], out[at], cols - 1);
+      std::complex<float>* sums = out[at].data() + r * n;
+      for (size_t i = 0; i < n; ++i) sums[i] = {re[i], im[i]};
     }
   }
 }

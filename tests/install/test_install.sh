@@ -31,7 +31,7 @@ echo "== cpack -G DEB"
 deb=$(ls "$STAGE"/pkg/tomomap_*_amd64.deb)
 depends=$(dpkg-deb -f "$deb" Depends)
 echo "Depends: $depends"
-for p in libfastrtps2.9 libfastcdr1 libopencv-core406 libpcl-common1.13 libpcl-io1.13 liblzf1 libsystemd0 libtomlplusplus3; do
+for p in libfastrtps2.9 libfastcdr1 libopencv-core406 libfftw3-single3 libpcl-common1.13 libpcl-io1.13 liblzf1 libsystemd0 libtomlplusplus3; do
   echo "$depends" | grep -q "$p" || fail "the .deb does not depend on $p"
 done
 echo "$depends" | grep -q -- "-dev" && fail "the .deb depends on a -dev package"

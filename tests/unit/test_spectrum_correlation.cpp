@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <complex>
 #include <opencv2/core.hpp>
 
 #include "core/spectrum_correlation.hpp"
@@ -9,50 +10,52 @@ using namespace tomomap;
 
 namespace {
 
-/// Spectra of random binary images of `size`; those listed in `empty` left empty, as the search leaves an empty
-/// slice's.
-std::vector<cv::Mat> spectra(int n, cv::Size size, std::initializer_list<int> empty, uint64_t seed) {
+/// Half spectra of random binary images of rows x cols; those listed in
+/// `empty` left empty, as the search leaves an empty slice's.
+std::vector<Spectrum> spectra(int n, int rows, int cols, std::initializer_list<int> empty, uint64_t seed) {
   cv::RNG rng(seed);
-  std::vector<cv::Mat> out(static_cast<size_t>(n));
+  const RealFft fft(rows, cols);
+  std::vector<Spectrum> out(static_cast<size_t>(n));
   for (int k = 0; k < n; ++k) {
     if (std::find(empty.begin(), empty.end(), k) != empty.end()) continue;
-    cv::Mat image(size, CV_32F);
-    rng.fill(image, cv::RNG::UNIFORM, 0, 2);
-    cv::Mat binary;
-    cv::Mat(image > 1.0).convertTo(binary, CV_32F, 1.0 / 255);
-    cv::dft(binary, out[static_cast<size_t>(k)]);
+    RealImage image(fft.imageSize());
+    for (float& v : image) v = rng.uniform(0, 2) == 1 ? 1.f : 0.f;
+    fft.forward(image, out[static_cast<size_t>(k)]);
   }
   return out;
 }
 
 }  // namespace
 
-TEST(SpectrumCorrelation, SumsWhatMulSpectrumsGivesOnEveryShape) {
-  // Odd and even widths and heights: the packed spectrum's first and last
-  // columns and rows are laid out differently for each.
-  for (const cv::Size size : {cv::Size(8, 6), cv::Size(9, 6), cv::Size(8, 5), cv::Size(15, 9), cv::Size(1, 4)}) {
-    const std::vector<cv::Mat> a = spectra(4, size, {2}, 1), b = spectra(3, size, {0}, 2);
-    std::vector<cv::Mat> sums;
+TEST(SpectrumCorrelation, SumsEveryOffsetsProductsOnEveryShape) {
+  // Odd and even widths and heights: a half spectrum's row holds cols / 2 + 1 values.
+  for (const auto& [rows, cols] : {std::pair{6, 8}, {6, 9}, {5, 8}, {9, 15}, {4, 1}}) {
+    const std::vector<Spectrum> a = spectra(4, rows, cols, {2}, 1), b = spectra(3, rows, cols, {0}, 2);
+    const size_t row = static_cast<size_t>(cols / 2 + 1);
+    std::vector<Spectrum> sums;
     std::vector<char> any;
-    correlateStacks(a, b, sums, any);
+    correlateStacks(a, b, row, sums, any);
     ASSERT_EQ(sums.size(), 6u);
     for (int dz = -2; dz <= 3; ++dz) {
-      cv::Mat expected, product;
+      std::vector<std::complex<double>> expected;
       for (int z = std::max(0, -dz); z < 3 && z + dz < 4; ++z) {
-        const cv::Mat &x = a[static_cast<size_t>(z + dz)], &y = b[static_cast<size_t>(z)];
+        const Spectrum &x = a[static_cast<size_t>(z + dz)], &y = b[static_cast<size_t>(z)];
         if (x.empty() || y.empty()) continue;
-        cv::mulSpectrums(x, y, product, 0, true);
-        if (expected.empty())
-          product.copyTo(expected);
-        else
-          expected += product;
+        expected.resize(x.size());
+        for (size_t i = 0; i < x.size(); ++i)
+          expected[i] += std::complex<double>(x[i]) * std::conj(std::complex<double>(y[i]));
       }
       const size_t at = static_cast<size_t>(dz + 2);
-      ASSERT_EQ(any[at] != 0, !expected.empty()) << size << " dz " << dz;
-      if (!expected.empty()) {
-        // Float sums of float products: what is left is rounding.
-        EXPECT_LE(cv::norm(sums[at], expected, cv::NORM_INF | cv::NORM_RELATIVE), 1e-6) << size << " dz " << dz;
+      ASSERT_EQ(any[at] != 0, !expected.empty()) << rows << " x " << cols << " dz " << dz;
+      if (expected.empty()) continue;
+      ASSERT_EQ(sums[at].size(), expected.size());
+      double largest = 0, off = 0;
+      for (size_t i = 0; i < expected.size(); ++i) {
+        largest = std::max(largest, std::abs(expected[i]));
+        off = std::max(off, std::abs(std::complex<double>(sums[at][i]) - expected[i]));
       }
+      // Float sums of float products: what is left is rounding.
+      EXPECT_LE(off, 1e-6 * largest) << rows << " x " << cols << " dz " << dz;
     }
   }
 }
@@ -60,23 +63,65 @@ TEST(SpectrumCorrelation, SumsWhatMulSpectrumsGivesOnEveryShape) {
 TEST(SpectrumCorrelation, AnOffsetWithoutAPairOfNonEmptySlicesIsNotSummed) {
   // b's only non-empty slice is its first, a's its first two: only at dz 0
   // and 1 does a non-empty slice meet another.
-  const std::vector<cv::Mat> a = spectra(4, cv::Size(6, 6), {2, 3}, 3), b = spectra(2, cv::Size(6, 6), {1}, 4);
-  std::vector<cv::Mat> sums;
+  const std::vector<Spectrum> a = spectra(4, 6, 6, {2, 3}, 3), b = spectra(2, 6, 6, {1}, 4);
+  std::vector<Spectrum> sums;
   std::vector<char> any;
-  correlateStacks(a, b, sums, any);
+  correlateStacks(a, b, 4, sums, any);
   ASSERT_EQ(any.size(), 5u);
   EXPECT_EQ(std::vector<char>(any.begin(), any.end()), (std::vector<char>{0, 1, 1, 0, 0}));
 }
 
 TEST(SpectrumCorrelation, StacksOfEmptySlicesSumNothing) {
   // A peer's map may come as slices without a cell: no offset is summed.
-  const std::vector<cv::Mat> empty(3), b = spectra(2, cv::Size(6, 6), {}, 5);
-  std::vector<cv::Mat> sums;
+  const std::vector<Spectrum> empty(3), b = spectra(2, 6, 6, {}, 5);
+  std::vector<Spectrum> sums;
   std::vector<char> any;
-  correlateStacks(empty, b, sums, any);
+  correlateStacks(empty, b, 4, sums, any);
   EXPECT_EQ(std::vector<char>(any.begin(), any.end()), std::vector<char>(4, 0));
-  correlateStacks(b, empty, sums, any);
+  correlateStacks(b, empty, 4, sums, any);
   EXPECT_EQ(std::vector<char>(any.begin(), any.end()), std::vector<char>(4, 0));
+}
+
+TEST(SpectrumCorrelation, TheInverseOfAProductIsTheCorrelationAtEveryShift) {
+  // Two binary images of 12 x 18, the second the first shifted by (3, -2):
+  // back from the spectra, every shift counts its coincident cells, most at (3, -2).
+  const int rows = 12, cols = 18;
+  const RealFft fft(rows, cols);
+  RealImage a(fft.imageSize(), 0.f), b(a);
+  cv::RNG rng(6);
+  for (int v = 2; v < 8; ++v)
+    for (int u = 4; u < 12; ++u)
+      if (rng.uniform(0, 2) == 1)
+        a[static_cast<size_t>(v * cols + u)] = 1.f, b[static_cast<size_t>((v + 2) * cols + u - 3)] = 1.f;
+  std::vector<Spectrum> sa(1), sb(1), sums;
+  fft.forward(a, sa[0]);
+  fft.forward(b, sb[0]);
+  std::vector<char> any;
+  correlateStacks(sa, sb, static_cast<size_t>(cols / 2 + 1), sums, any);
+  RealImage back;
+  fft.inverse(sums[0], back);
+  for (int dy = 0; dy < rows; ++dy)
+    for (int dx = 0; dx < cols; ++dx) {
+      double coincide = 0;  // sum over pixels of a(p + d) b(p), wrapping around
+      for (int v = 0; v < rows; ++v)
+        for (int u = 0; u < cols; ++u)
+          coincide +=
+              a[static_cast<size_t>(((v + dy) % rows) * cols + (u + dx) % cols)] * b[static_cast<size_t>(v * cols + u)];
+      ASSERT_NEAR(back[static_cast<size_t>(dy * cols + dx)] / static_cast<double>(fft.imageSize()), coincide, 1e-3)
+          << dx << ", " << dy;
+    }
+  const size_t top = static_cast<size_t>(std::max_element(back.begin(), back.end()) - back.begin());
+  EXPECT_EQ(top % cols, 3u);
+  EXPECT_EQ(top / cols, static_cast<size_t>(rows - 2));
+}
+
+TEST(SpectrumCorrelation, TransformSizesAreTwosAndThrees) {
+  EXPECT_EQ(RealFft::fastSize(1), 2);
+  EXPECT_EQ(RealFft::fastSize(130), 144);  // OpenCV's optimal size was 135 = 3^3 5
+  EXPECT_EQ(RealFft::fastSize(140), 144);
+  EXPECT_EQ(RealFft::fastSize(145), 162);
+  EXPECT_EQ(RealFft::fastSize(64), 64);
+  EXPECT_EQ(RealFft::fastSize(65), 72);
 }
 
 TEST(SpectrumCorrelation, AnOffsetsBoundIsTheSumOfItsSlicePairsFewerCells) {
@@ -93,31 +138,32 @@ TEST(SpectrumCorrelation, NoOffsetPeaksAboveItsBoundAndOneStackOnItselfReachesIt
   // Random binary slices, zero-padded as the search pads them: every
   // offset's correlation peaks within its bound, and a stack laid on itself
   // at offset 0 scores every cell it has.
-  const cv::Size size(12, 10), padded(24, 20);
+  const int rows = 10, cols = 12;
+  const RealFft fft(20, 24);  // zero-padded
   cv::RNG rng(6);
   const auto stack = [&](int n) {
-    std::vector<cv::Mat> spectra(static_cast<size_t>(n));
+    std::vector<Spectrum> spectra(static_cast<size_t>(n));
     std::vector<int> cells(spectra.size());
     for (size_t k = 0; k < spectra.size(); ++k) {
-      cv::Mat noise(size, CV_32F), big = cv::Mat::zeros(padded, CV_32F);
-      rng.fill(noise, cv::RNG::UNIFORM, 0, 2);
-      cv::Mat(noise > 1.4).convertTo(big(cv::Rect(cv::Point(0, 0), size)), CV_32F, 1.0 / 255);
-      cells[k] = cv::countNonZero(big);
-      cv::dft(big, spectra[k]);
+      RealImage big(fft.imageSize(), 0.f);
+      for (int v = 0; v < rows; ++v)
+        for (int u = 0; u < cols; ++u)
+          if (rng.uniform(0.0, 2.0) > 1.4) big[static_cast<size_t>(v * fft.cols() + u)] = 1.f, ++cells[k];
+      fft.forward(big, spectra[k]);
     }
     return std::pair{spectra, cells};
   };
   const auto [a, a_cells] = stack(4);
   const auto [b, b_cells] = stack(3);
-  const auto peaks = [](const std::vector<cv::Mat>& x, const std::vector<cv::Mat>& y) {
-    std::vector<cv::Mat> sums;
+  const auto peaks = [&fft](const std::vector<Spectrum>& x, const std::vector<Spectrum>& y) {
+    std::vector<Spectrum> sums;
     std::vector<char> any;
-    correlateStacks(x, y, sums, any);
+    correlateStacks(x, y, static_cast<size_t>(fft.cols() / 2 + 1), sums, any);
     std::vector<double> out(sums.size(), 0);
     for (size_t at = 0; at < sums.size(); ++at) {
-      cv::Mat corr;
-      cv::dft(sums[at], corr, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
-      cv::minMaxLoc(corr, nullptr, &out[at]);
+      RealImage corr;
+      fft.inverse(sums[at], corr);
+      out[at] = *std::max_element(corr.begin(), corr.end()) / static_cast<double>(fft.imageSize());
     }
     return out;
   };
