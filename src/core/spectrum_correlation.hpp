@@ -39,8 +39,8 @@ using Spectrum = std::vector<std::complex<float>, FftwAllocator<std::complex<flo
 /// Real 2D transforms of one size, single precision (FFTW). Planned once per
 /// size in a process and kept (FFTW's planner is not thread-safe; running a
 /// plan is, on arrays of its own). On the wide search's rasters, against
-/// OpenCV's dft: 28 us forward and 30 us back at 144 x 144, where OpenCV took
-/// 80-170 and 110-280 us at its own optimal 144 x 135 (docs/results.md,
+/// OpenCV's dft: 28-45 us forward and 30-45 us back at 144 x 144, where OpenCV
+/// took 80-170 and 110-280 us at its own optimal 144 x 135 (docs/results.md,
 /// "Transforms by FFTW").
 class RealFft {
  public:
@@ -55,8 +55,9 @@ class RealFft {
   /// inverse leaves the scale), into `out`; `spectrum` is used up (FFTW's
   /// inverse of more than one dimension works in its input).
   void inverse(Spectrum& spectrum, RealImage& out) const;
-  /// The smallest size of at least `n` of the form 2^a 3^b, a >= 1: FFTW is
-  /// fastest on those (at 135 = 3^3 5 it was 4 times slower than at 144).
+  /// The smallest size of at least `n` of the form 2^a times 1, 3, 5 or 9
+  /// (a >= 1): FFTW, planned without measuring, is fastest on those, 2 ns
+  /// a pixel at 144 and 160, 4.5 at 162 = 2 3^4 (and 6 at OpenCV's 135).
   static int fastSize(int n);
 
  private:
