@@ -658,11 +658,19 @@ DenseSearch searchDensely(const PoseLander& land, const ConsensusParams& same, c
             const size_t at = static_cast<size_t>(dz + zs - 1);
             if (!summed[at]) continue;
             fft.inverse(sums[at], corr);
-            const size_t top = static_cast<size_t>(std::max_element(corr.begin(), corr.end()) - corr.begin());
+            // A shift's value counts coincident cells: a whole number, up to
+            // the transforms' rounding (thousandths). The peak is the first
+            // shift, in the raster's order, at the largest whole count: on
+            // sparse crops many shifts tie there, and which one a search
+            // keeps is then not a matter of how the transforms round.
+            const double most = std::round(scale * *std::max_element(corr.begin(), corr.end()));
+            const auto least = static_cast<float>((most - 0.5) / scale);
+            const size_t top = static_cast<size_t>(
+                std::find_if(corr.begin(), corr.end(), [least](float v) { return v >= least; }) - corr.begin());
             const int x = static_cast<int>(top % static_cast<size_t>(fft.cols())),
                       y = static_cast<int>(top / static_cast<size_t>(fft.cols()));
             const int dx = x < xt ? x : x - fft.cols(), dy = y < yt ? y : y - fft.rows();
-            peaks[static_cast<size_t>(step)][at] = Peak{scale * corr[top], step, dz, dx, dy};
+            peaks[static_cast<size_t>(step)][at] = Peak{most, step, dz, dx, dy};
           }
         }
         for (size_t i : set) simg[i / fft.imageSize()][i % fft.imageSize()] = 0.f;
