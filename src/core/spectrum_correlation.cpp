@@ -59,8 +59,17 @@ void* fftwAllocate(size_t bytes) {
 
 void fftwFree(void* p) noexcept { fftwf_free(p); }
 
+/// A size's two plans, destroyed with the process's table of them (at exit):
+/// FFTW's memory for a plan is its own, and a plan left undestroyed leaks it.
 struct RealFft::Plans {
   fftwf_plan forward = nullptr, inverse = nullptr;
+  Plans() = default;
+  Plans(const Plans&) = delete;
+  Plans& operator=(const Plans&) = delete;
+  ~Plans() {
+    if (forward) fftwf_destroy_plan(forward);
+    if (inverse) fftwf_destroy_plan(inverse);
+  }
 };
 
 RealFft::RealFft(int rows, int cols) : rows_(rows), cols_(cols) {
