@@ -91,7 +91,7 @@ class BitRaster {
 /// A stack of rasters of one size read down its columns: per pixel, a bit
 /// per raster. Choosing a pose's height tests each cell of it on every
 /// slice within reach; down a column those are one or two words, where the
-/// rasters are a word each (dense_search.cpp, mostInliersAt). It takes a
+/// rasters are a word each (pose_judge.hpp, mostInliersAt). It takes a
 /// word per pixel per 64 rasters, whatever they hold: for the small maps a
 /// dense search searches, not for every stack.
 class BitColumns {

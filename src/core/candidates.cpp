@@ -77,17 +77,15 @@ std::vector<Candidate> refineAndLand(const MapFeatures& target, const MapFeature
                                      const std::vector<Proposal>& proposals, const MatchParams& params,
                                      const FeatureVotes& votes) {
   if (proposals.empty()) return {};
-  DenseSearchParams dp;
-  dp.threads = matchThreads(params);
-  return refineAndLand(PoseLander(target.occupancy, source.occupancy, dp), target, source, proposals, params, votes);
+  return refineAndLand(PoseLander(target.occupancy, source.occupancy, denseSearchParams(params)), target, source,
+                       proposals, params, votes);
 }
 
 std::vector<Candidate> refineAndLand(const PoseLander& land, const MapFeatures& target, const MapFeatures& source,
                                      const std::vector<Proposal>& proposals, const MatchParams& params,
                                      const FeatureVotes& votes) {
   if (proposals.empty()) return {};
-  DenseSearchParams dp;
-  dp.threads = matchThreads(params);
+  const DenseSearchParams dp = denseSearchParams(params);
   std::vector<std::pair<Rigid2D, int>> poses;
   for (const Proposal& p : proposals) poses.emplace_back(p.T, p.offset);
   const std::vector<DensePose> as_proposed = land(poses);

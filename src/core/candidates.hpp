@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "dense_search.hpp"
+#include "pose_lander.hpp"
 #include "features.hpp"
 #include "match_params.hpp"
 

@@ -3,11 +3,12 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
 #include <tuple>
 
 #include "dense_refine.hpp"
-#include "dense_search.hpp"
 #include "height_offsets.hpp"
+#include "pose_lander.hpp"
 
 namespace tomomap {
 namespace {
@@ -43,7 +44,8 @@ int firstSlice(const SliceStack& searched, const SliceStack& own, int pooling) {
 /// `land`, where given, is the lander of `t` and `s` already prepared.
 Opinion searchAt(const MapFeatures& target, const MapFeatures& source, const SliceStack& t, const SliceStack& s,
                  int pooling, const MatchParams& params, DenseSearchParams dp = {}, const PoseLander* land = nullptr) {
-  dp.threads = matchThreads(params);
+  if (land && !land->lands(t, s)) throw std::logic_error("searchAt: a lander of other stacks");
+  dp = denseSearchParams(params, dp);
   const ConsensusParams same = consensusParams(params, t.grid.cell);
   Opinion o{land ? searchDensely(*land, same, source.centre(), dp) : searchDensely(t, s, same, source.centre(), dp),
             pooling, same};
@@ -121,11 +123,7 @@ CandidateVerdict decide(MatchResult& r, const FeatureProposals& f, const std::op
   // for the wide search and the candidates.
   std::optional<PoseLander> prepared;
   const auto land = [&]() -> const PoseLander& {
-    if (!prepared) {
-      DenseSearchParams dp;
-      dp.threads = matchThreads(params);
-      prepared.emplace(target.occupancy, source.occupancy, dp);
-    }
+    if (!prepared) prepared.emplace(target.occupancy, source.occupancy, denseSearchParams(params));
     return *prepared;
   };
   if (denseSearchable(target.occupancy, wideSearch()) && denseSearchable(source.occupancy, wideSearch()))

@@ -1,13 +1,10 @@
 #pragma once
 // A dense search for small maps: every yaw, shift and height offset scored by
 // how much of the two maps' occupancy coincides, without features.
-#include <memory>
-#include <optional>
 #include <vector>
 
-#include "bit_raster.hpp"
 #include "consensus.hpp"
-#include "dense_refine.hpp"
+#include "match_params.hpp"
 #include "rigid2d.hpp"
 #include "slices.hpp"
 
@@ -38,6 +35,10 @@ struct DenseSearchParams {
   double finest_empty_cell = 0.1;
   int threads = 1;
 };
+
+/// `dp` on the threads `params` asks for (matchThreads): how a match runs
+/// the dense search and prepares a lander.
+DenseSearchParams denseSearchParams(const MatchParams& params, DenseSearchParams dp = {});
 
 /// A map is small enough for the dense search when its coarse cell need not be
 /// larger than this many grid cells: the search then stays under a second and
@@ -84,6 +85,8 @@ struct DensePose {
   double score() const;
 };
 
+class PoseLander;  // pose_lander.hpp
+
 struct DenseSearch {
   /// False when the maps are too large for it (see kMaxCoarsening) or empty.
   bool searched = false;
@@ -92,82 +95,6 @@ struct DenseSearch {
 
 /// Whether `stack` is small enough for searchDensely and holds every slice's cells.
 bool denseSearchable(const SliceStack& stack, const DenseSearchParams& params = {});
-
-/// The height offset (target slice index - source slice index) within `reach`
-/// slices of `middle` at which `T` lands the most source cells within
-/// inlier_radius_cells of a target cell; `middle` where none lands more. The
-/// dense search places each of its poses by the same count (the first of the
-/// most within one coarse cell of height).
-int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
-                          const DenseSearchParams& params = {});
-
-/// The pose (T, offset) judged as the search judges its poses (inliers, telling
-/// cells both ways, what it contradicts), without searching or refining: for a
-/// pose found otherwise, such as the features' answer. Of a partial stack
-/// (SliceStack::partial) the slices whose cells it holds land; the others
-/// land nothing and enclose no empty space, so that what the pose
-/// contradicts there is a part of what it would contradict on the whole map.
-DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
-                   const DenseSearchParams& params = {});
-
-/// How a pose lands one source slice's cells on the target (landPose's counts, slice by slice).
-struct SliceLanding {
-  int slice = 0;         ///< source slice index
-  uint32_t cells = 0;    ///< its occupied cells
-  uint32_t telling = 0;  ///< of them, telling (dense_search.cpp, cellsOf)
-  uint32_t seen = 0;     ///< landing where the target saw anything, at any height
-  uint32_t on = 0;       ///< landing on target cells (within inlier_radius_cells)
-  uint32_t telling_on = 0;
-  uint32_t contradicted = 0;  ///< telling cells landing in space the target saw empty
-};
-
-/// Each pose (T, offset) landed slice by slice, the source's cells on the
-/// target alone (the candidates' landings, candidates.hpp). PoseLander::slices
-/// with the stacks prepared once.
-std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, const SliceStack& source,
-                                                  const std::vector<std::pair<Rigid2D, int>>& poses,
-                                                  const DenseSearchParams& params = {});
-
-namespace dense_detail {
-/// What a pose is judged on, built once per pair of maps (dense_search.cpp).
-struct PoseJudge;
-}  // namespace dense_detail
-
-/// The two maps' occupancy prepared once for judging and refining poses on
-/// it, for a caller that does so again and again (a climb, nearby_poses.hpp; a
-/// dense search and the candidates on the same maps: preparing it took a
-/// tenth of a room pair's match at 0.05 m cells, each time). The stacks must
-/// outlive it.
-class PoseLander {
- public:
-  using Poses = std::vector<std::pair<Rigid2D, int>>;  ///< (T, offset) each
-  PoseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params = {});
-  /// Each pose landed (landPose).
-  std::vector<DensePose> operator()(const Poses& poses) const;
-  /// Each pose's DensePose::score() alone, counted on the telling cells alone
-  /// (the only ones it weighs): for a caller that ranks many poses and lands
-  /// only the best (a climb, nearby_poses.hpp).
-  std::vector<double> scores(const Poses& poses) const;
-  /// Each pose landed slice by slice (landSlices).
-  std::vector<std::vector<SliceLanding>> slices(const Poses& poses) const;
-  /// occupancyHeightOffset on the occupancy prepared.
-  int heightOffset(const Rigid2D& T, int middle, int reach) const;
-  /// refineOnOccupancy on the same two stacks (dense_refine.hpp), prepared with them.
-  const OccupancyRefiner& refiner() const;
-
- private:
-  friend DenseSearch searchDensely(const PoseLander& land, const ConsensusParams& same, const Eigen::Vector2d& pivot,
-                                   const DenseSearchParams& params);
-  std::shared_ptr<const dense_detail::PoseJudge> judge_;
-  struct Refiner;  ///< made when first asked for: a landing alone needs none
-  std::shared_ptr<Refiner> refine_;
-  /// The target's dilated slices down its columns; null on maps the wide search does not reach.
-  std::shared_ptr<const BitColumns> columns_;
-  int threads_ = 1;
-};
-
-/// landPose with a lander: (T, offset) landed.
-DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset);
 
 /// Correlates the maps' occupancy on a coarse raster at every yaw step, shift
 /// and height offset (FFT per slice pair), then refines the best distinct

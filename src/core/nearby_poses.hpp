@@ -2,7 +2,7 @@
 // The pose uphill of a pose on the maps' occupancy: how each candidate is
 // refined before it is judged (candidates.hpp).
 #include "dense_refine.hpp"
-#include "dense_search.hpp"
+#include "pose_lander.hpp"
 
 namespace tomomap {
 
@@ -18,7 +18,7 @@ namespace tomomap {
 /// (T, offset) itself, landed, where nothing uphill lands more.
 DensePose uphill(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
                  const DenseSearchParams& params = {});
-/// uphill with `land`, the two stacks' lander (dense_search.hpp) the caller
+/// uphill with `land`, the two stacks' lander (pose_lander.hpp) the caller
 /// has prepared already: one preparation serves every step of every climb on them.
 DensePose uphill(const PoseLander& land, const Rigid2D& T, int offset, int threads = 1);
 

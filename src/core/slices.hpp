@@ -47,7 +47,7 @@ struct SliceStack {
   std::vector<std::vector<uint32_t>> cells;  ///< per slice; empty = too sparse to describe (kSparsestSlice)
   /// Per slice, whether the map had any point at its height: a slice too
   /// sparse to describe was seen, a slab between two floors was not (the
-  /// empty space a pose is judged on reads the difference: dense_search.cpp,
+  /// empty space a pose is judged on reads the difference: enclosure.hpp,
   /// Enclosure). Empty where not known: every slice seen (seenAt).
   std::vector<bool> seen{};
   size_t stray = 0;  ///< points left out as stray returns (map_bounds.hpp)

@@ -7,6 +7,7 @@
 #include "core/candidates.hpp"
 #include "core/dense_refine.hpp"
 #include "core/dense_search.hpp"
+#include "core/pose_lander.hpp"
 #include "core/matcher.hpp"
 #include "core/nearby_poses.hpp"
 #include "core/voxel_filter.hpp"

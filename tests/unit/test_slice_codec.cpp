@@ -144,7 +144,7 @@ TEST(SliceCodec, InconsistentSamplesAreRejectedNotCrashed) {
 
 // The heights at which a map had no point (the slab between the building's
 // floors) travel with it: a receiver judges the empty space a pose lands in
-// as the owner does (dense_search.cpp, Enclosure). Announcements that lie
+// as the owner does (enclosure.hpp). Announcements that lie
 // about them are refused.
 TEST(SliceCodec, TheHeightsAMapSawNothingAtTravelWithIt) {
   synth::SceneParams sp;

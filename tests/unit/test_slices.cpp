@@ -101,7 +101,7 @@ TEST(Slices, ASparseSliceIsKeptButNotAmongTheFullSlices) {
 
 // A height where the map had no point was not seen (a slab between two
 // floors); one with too few points to describe was: the empty space a pose
-// is judged on reads the difference (dense_search.cpp, Enclosure). Slicing,
+// is judged on reads the difference (enclosure.hpp). Slicing,
 // pooling and keeping the full slices carry it along.
 TEST(Slices, AHeightWithNoPointIsUnseenWhereASparseOneIsSeen) {
   Points pts = room(0.05);

@@ -1,0 +1,145 @@
+#include "pose_lander.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <tuple>
+
+#include "pose_judge.hpp"
+
+namespace tomomap {
+
+using namespace dense_detail;
+
+namespace {
+
+/// The height offset within `reach` slices of `middle` at which `T` lands
+/// the most source `cells` on the `dilated` target slices of raster `grid`
+/// (occupancyHeightOffset).
+template <typename Columns>
+int mostInliersNear(const Columns& dilated, const std::vector<Cell>& cells, const SliceGrid& grid, const Rigid2D& T,
+                    int middle, int reach) {
+  return mostInliersAt(dilated, cells, landings(cells, T, grid), middle - reach, 2 * reach + 1, middle);
+}
+
+/// `poses` by transform: the indices of the poses of each distinct one, told
+/// apart by their bits (so that -0.0 and a NaN are transforms of their own).
+std::vector<std::vector<size_t>> byTransform(const PoseLander::Poses& poses) {
+  const auto bits = [](double x) {
+    uint64_t b;
+    std::memcpy(&b, &x, sizeof b);
+    return b;
+  };
+  std::map<std::tuple<uint64_t, uint64_t, uint64_t>, size_t> index;
+  std::vector<std::vector<size_t>> out;
+  for (size_t n = 0; n < poses.size(); ++n) {
+    const Rigid2D& T = poses[n].first;
+    const auto [at, added] = index.try_emplace({bits(T.yaw), bits(T.t.x()), bits(T.t.y())}, out.size());
+    if (added) out.emplace_back();
+    out[at->second].push_back(n);
+  }
+  return out;
+}
+
+/// Calls f(n, forth, back) for each of `poses` with where its transform lands
+/// `forth_cells` on the target and `back_cells` on the source: landed once
+/// per distinct transform (a climb's steps and a ring of shifts land each at
+/// several heights, and where a transform lands the cells does not depend on
+/// the height), the transforms spread over `threads`.
+template <typename F>
+void forEachLanding(const PoseJudge& judge, const PoseLander::Poses& poses, const std::vector<Cell>& forth_cells,
+                    const std::vector<Cell>& back_cells, int threads, const F& f) {
+  const std::vector<std::vector<size_t>> groups = byTransform(poses);
+#pragma omp parallel for schedule(dynamic) num_threads(threads)
+  for (size_t g = 0; g < groups.size(); ++g) {
+    const Rigid2D& T = poses[groups[g].front()].first;
+    const std::vector<int> forth = landings(forth_cells, T, judge.target.grid),
+                           back = landings(back_cells, T.inverse(), judge.source.grid);
+    for (size_t n : groups[g]) f(n, forth, back);
+  }
+}
+
+}  // namespace
+
+std::vector<std::vector<SliceLanding>> landSlices(const SliceStack& target, const SliceStack& source,
+                                                  const std::vector<std::pair<Rigid2D, int>>& poses,
+                                                  const DenseSearchParams& params) {
+  return PoseLander(target, source, params).slices(poses);
+}
+
+PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params)
+    : judge_(std::make_shared<const PoseJudge>(target, source, params)),
+      refine_(std::make_shared<Refiner>()),
+      threads_(std::max(1, params.threads)) {
+  // On maps a dense search reaches (the wide one's bound: BitColumns take a
+  // word a pixel per 64 slices, at most a few MB there) a pose's height is
+  // read down the target's columns; on larger ones, slice by slice.
+  DenseSearchParams widest = params;
+  widest.coarse_side = std::max(params.coarse_side, kWideCoarseSide);
+  if (denseSearchable(target, widest))
+    columns_ = std::make_shared<const BitColumns>(columnsOf(judge_->dilated, target.grid));
+}
+
+std::vector<DensePose> PoseLander::operator()(const Poses& poses) const {
+  std::vector<DensePose> out(poses.size());
+  forEachLanding(*judge_, poses, judge_->source_cells, judge_->target_cells, threads_,
+                 [&](size_t n, const std::vector<int>& forth, const std::vector<int>& back) {
+                   DensePose& p = out[n];
+                   p.transform = poses[n].first, p.offset = poses[n].second;
+                   PoseJudge::judge(p, judge_->forth(forth, p.offset), judge_->backwards(back, p.offset));
+                 });
+  return out;
+}
+
+std::vector<double> PoseLander::scores(const Poses& poses) const {
+  std::vector<double> out(poses.size());
+  forEachLanding(*judge_, poses, judge_->source_telling, judge_->target_telling, threads_,
+                 [&](size_t n, const std::vector<int>& forth, const std::vector<int>& back) {
+                   out[n] = judge_->score(poses[n].first, poses[n].second, forth, back);
+                 });
+  return out;
+}
+
+std::vector<std::vector<SliceLanding>> PoseLander::slices(const Poses& poses) const {
+  std::vector<std::vector<SliceLanding>> out(poses.size());
+#pragma omp parallel for schedule(dynamic) num_threads(threads_)
+  for (size_t n = 0; n < poses.size(); ++n)
+    judge_->forth(landings(judge_->source_cells, poses[n].first, judge_->target.grid), poses[n].second, &out[n]);
+  return out;
+}
+
+int PoseLander::heightOffset(const Rigid2D& T, int middle, int reach) const {
+  if (columns_) return mostInliersNear(*columns_, judge_->source_cells, judge_->target.grid, T, middle, reach);
+  return mostInliersNear(SliceWindows{judge_->dilated}, judge_->source_cells, judge_->target.grid, T, middle, reach);
+}
+
+bool PoseLander::lands(const SliceStack& target, const SliceStack& source) const {
+  return &judge_->target == &target && &judge_->source == &source;
+}
+
+struct PoseLander::Refiner {
+  std::once_flag made;
+  std::optional<OccupancyRefiner> refiner;
+};
+
+const OccupancyRefiner& PoseLander::refiner() const {
+  std::call_once(refine_->made, [this] { refine_->refiner.emplace(judge_->target, judge_->source); });
+  return *refine_->refiner;
+}
+
+DensePose landPose(const PoseLander& land, const Rigid2D& T, int offset) { return land({{T, offset}}).front(); }
+
+DensePose landPose(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int offset,
+                   const DenseSearchParams& params) {
+  return landPose(PoseLander(target, source, params), T, offset);
+}
+
+int occupancyHeightOffset(const SliceStack& target, const SliceStack& source, const Rigid2D& T, int middle, int reach,
+                          const DenseSearchParams& params) {
+  return mostInliersNear(SliceWindows{dilatedSlices(target, params)}, cellsOf(source, params.wall_spread), target.grid,
+                         T, middle, reach);
+}
+
+}  // namespace tomomap
