@@ -46,6 +46,23 @@ struct Patch {
   double weight;
 };
 
+/// The points of a map one measurement reads, read where they lie rather
+/// than copied (copies of a sample and its parts took 26 MB a map, and their
+/// pages' faults were among the slowest matrix pair's costs): every
+/// `stride`-th point, and of those, for a half, the ones on one side of
+/// `cut` along `along`.
+struct Part {
+  size_t stride = 1;
+  bool half = false;
+  Eigen::Vector3f along = Eigen::Vector3f::Zero();
+  float cut = 0;
+  bool below = true;  ///< the half below `cut`; else the one at or above it
+  bool holds(const Eigen::Vector3f& p) const { return !half || (p.dot(along) < cut) == below; }
+};
+
+/// Every k-th point of `map`: a few hundred thousand describe the large surfaces.
+Part sampleOf(const Points& map) { return {std::max<size_t>(1, map.size() / kMaxPoints)}; }
+
 /// `turn` * `p` summed as Eigen sums it, the first term plus the sum of the
 /// other two (its unrolled sum splits three terms as one and two; on x86-64 a
 /// Vector3f is shorter than a packet, so it is not vectorised), so that the
@@ -56,10 +73,10 @@ Eigen::Vector3f turnedBy(const Eigen::Matrix3f& turn, const Eigen::Vector3f& p) 
   return {row(0), row(1), row(2)};
 }
 
-/// Every `stride`-th point of `map`, turned by `turn`, binned in cubes of `side`.
+/// The points of `part` of `map`, turned by `turn`, binned in cubes of `side`.
 /// The points are read where they lie, not copied: a sample of a large map,
 /// and its turned copy, would sit beside the voxel filter's buffers.
-std::vector<Patch> flatPatches(const Points& map, size_t stride, const Eigen::Matrix3f& turn, double side) {
+std::vector<Patch> flatPatches(const Points& map, const Part& part, const Eigen::Matrix3f& turn, double side) {
   struct Sums {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
@@ -67,7 +84,8 @@ std::vector<Patch> flatPatches(const Points& map, size_t stride, const Eigen::Ma
   };
   std::unordered_map<uint64_t, Sums> cubes;
   const bool turned = !turn.isIdentity(0.0f);
-  for (size_t i = 0; i < map.size(); i += stride) {
+  for (size_t i = 0; i < map.size(); i += part.stride) {
+    if (!part.holds(map[i])) continue;
     const Eigen::Vector3f p = turned ? turnedBy(turn, map[i]) : map[i];
     Sums& s = cubes[latticeKey(p, side)];
     const Eigen::Vector3d q = p.cast<double>();
@@ -181,12 +199,9 @@ std::optional<Cue> upOf(const std::vector<Patch>& patches, Tilt& t) {
   return found;
 }
 
-/// The estimate itself (see estimateTilt): `up` from the flat patches of every
-/// `stride`-th point, measured again in the frame levelled so far.
-Tilt measureTilt(const Points& map, double grid) {
-  // Every k-th point: a few hundred thousand describe the large surfaces.
-  const size_t stride = std::max<size_t>(1, map.size() / kMaxPoints);
-
+/// The estimate itself (see estimateTilt): `up` from the flat patches of
+/// `part` of `map`, measured again in the frame levelled so far.
+Tilt measureTilt(const Points& map, double grid, const Part& part) {
   // The cubes are axis-aligned: a leaning floor cut at a cube's top and bottom
   // fits a little flatter than it is (a 10 deg lean read as 9.3). Measured
   // again in the frame levelled so far, the cut runs along the floor.
@@ -195,7 +210,7 @@ Tilt measureTilt(const Points& map, double grid) {
   const double side = std::max(kMinPatchSide, kPatchCells * grid);
   for (int pass = 0; pass < kPasses; ++pass) {
     const Eigen::Matrix3f turn = leveling.toRotationMatrix().cast<float>();  // as rotatePoints turns
-    const auto cue = upOf(flatPatches(map, stride, turn, side), t);
+    const auto cue = upOf(flatPatches(map, part, turn, side), t);
     if (!cue) return t;
     leveling = Eigen::Quaterniond::FromTwoVectors(cue->up, Eigen::Vector3d::UnitZ()) * leveling;
     t.uncertainty = cue->error();
@@ -209,45 +224,30 @@ Tilt measureTilt(const Points& map, double grid) {
 /// The parts of a map the estimate is measured on again: its halves either
 /// side of the median along four directions 45 degrees apart (a crop to
 /// half, as another robot would map the place), and every third and every
-/// tenth point (a sparser sensor). Each part of a sample of at most kMaxPoints.
-std::vector<Points> partsOf(const Points& map) {
-  const size_t stride = std::max<size_t>(1, map.size() / kMaxPoints);
-  // Every vector is sized before it is filled: growing one on huge pages
-  // faults its pages in and clears them again at every reallocation, which
-  // `perf` showed among the slowest matrix pair's costs.
-  Points sample;
-  sample.reserve(map.size() / stride + 1);
-  for (size_t i = 0; i < map.size(); i += stride) sample.push_back(map[i]);
-  std::vector<Points> parts;
+/// tenth point (a sparser sensor). Each part of the sample (sampleOf): a
+/// sample holds fewer than 2 kMaxPoints points, so each part is read whole.
+std::vector<Part> partsOf(const Points& map) {
+  const Part sample = sampleOf(map);
+  std::vector<Part> parts;
+  std::vector<float> v;
+  v.reserve(map.size() / sample.stride + 1);
   for (int k = 0; k < kCutDirections; ++k) {
     const double a = kPi * k / kCutDirections;
     const Eigen::Vector3f along(static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a)), 0.0f);
-    std::vector<float> v;
-    v.reserve(sample.size());
-    for (const auto& p : sample) v.push_back(p.dot(along));
+    v.clear();
+    for (size_t i = 0; i < map.size(); i += sample.stride) v.push_back(map[i].dot(along));
     std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
     const float median = v[v.size() / 2];
-    Points low, high;
-    const auto below = static_cast<size_t>(std::count_if(v.begin(), v.end(), [&](float x) { return x < median; }));
-    low.reserve(below);
-    high.reserve(sample.size() - below);
-    for (const auto& p : sample) (p.dot(along) < median ? low : high).push_back(p);
-    parts.push_back(std::move(low));
-    parts.push_back(std::move(high));
+    for (const bool below : {true, false}) parts.push_back({sample.stride, true, along, median, below});
   }
-  for (size_t thinning : kPartThinnings) {
-    Points thin;
-    thin.reserve(sample.size() / thinning + 1);
-    for (size_t i = 0; i < sample.size(); i += thinning) thin.push_back(sample[i]);
-    parts.push_back(std::move(thin));
-  }
+  for (size_t thinning : kPartThinnings) parts.push_back({sample.stride * thinning});
   return parts;
 }
 
 }  // namespace
 
 Tilt estimateTilt(const Points& map, double grid) {
-  Tilt t = measureTilt(map, grid);
+  Tilt t = measureTilt(map, grid, sampleOf(map));
   if (!t.measured) return t;
   // A standard error counts the patches as independent; they are not (a
   // road that slopes, one wall that leans): on the real scans, halves of a
@@ -263,11 +263,11 @@ Tilt estimateTilt(const Points& map, double grid) {
   // to that much farther on the real maps).
   size_t checks = 0;
   double farthest = 0;
-  const std::vector<Points> parts = partsOf(map);
-  for (const auto& part : parts) {
+  const std::vector<Part> parts = partsOf(map);
+  for (const Part& part : parts) {
     // The same estimate a crop of the map would get (one pass from the
     // whole's frame read campus-1's halves 0.1 deg nearer than a crop's own).
-    const Tilt p = measureTilt(part, grid);
+    const Tilt p = measureTilt(map, grid, part);
     if (!fairPart(p, t)) continue;
     ++checks;
     farthest = std::max(farthest, std::acos(std::clamp(p.up.dot(t.up), -1.0, 1.0)));
