@@ -246,9 +246,9 @@ std::vector<Part> partsOf(const Points& map) {
 
 }  // namespace
 
-Tilt estimateTilt(const Points& map, double grid) {
+Tilt estimateTilt(const Points& map, double grid, double matched_within) {
   Tilt t = measureTilt(map, grid, sampleOf(map));
-  if (!t.measured) return t;
+  if (!t.measured || t.angle <= matched_within) return t;
   // A standard error counts the patches as independent; they are not (a
   // road that slopes, one wall that leans): on the real scans, halves of a
   // map read 0.5-2.5 deg from the whole with standard errors of 0.1-0.3. The

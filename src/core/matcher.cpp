@@ -157,8 +157,9 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   // points alone, and took as long as both on a street): the map is sliced
   // before the tilt is known, and sliced again in the rare case it is levelled.
   // From the raw points: the filter's grid would bias a leaning plane's normals towards the axes.
-  std::future<Tilt> tilt_estimate = std::async(threads > 1 && !up ? std::launch::async : std::launch::deferred,
-                                               [&] { return up ? givenTilt(*up) : estimateTilt(map, params.grid); });
+  std::future<Tilt> tilt_estimate = std::async(threads > 1 && !up ? std::launch::async : std::launch::deferred, [&] {
+    return up ? givenTilt(*up) : estimateTilt(map, params.grid, params.max_tilt);
+  });
   auto t0 = Clock::now();
   Eigen::Vector3f corner = previous ? previous->voxel_corner : Eigen::Vector3f::Constant(NAN);
   Points filtered = voxelFilter(map, params.grid, &corner);
