@@ -92,7 +92,9 @@ void printResult(std::ostream& out, const MatchResult& r, const std::optional<Gr
       out << format("dense search     at the map's cells its best pose leads the next by %.2fx\n", d.at_grid_lead);
     if (d.pooled_lead > 0)
       out << format("                 on occupancy pooled to twice the cell: %.2fx\n", d.pooled_lead);
-    if (d.wide_lead > 0) out << format("                 on a raster twice as fine: %.2fx\n", d.wide_lead);
+    if (d.wide_lead > 0)
+      out << format("                 on a raster twice as fine, over its next or a candidate elsewhere: %.2fx\n",
+                    d.wide_lead);
     if (d.second_look_apart)
       out << format("                 with the maps' roles swapped, the source's origin %.3f m from its pose\n",
                     *d.second_look_apart);

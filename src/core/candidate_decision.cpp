@@ -284,6 +284,17 @@ void bySecondLook(CandidateVerdict& v, const std::vector<Candidate>& candidates,
   }
 }
 
+/// "The same pose": the same place (onePlace) within one consensus
+/// tolerance at the source raster's centre, the consensus yaw and half the
+/// smear of heights.
+struct SamePose {
+  ConsensusParams tolerance;
+  Eigen::Vector2d source_centre;
+  bool operator()(const DensePose& a, const DensePose& b) const {
+    return onePlace(a.transform, a.offset, b.transform, b.offset, tolerance, source_centre);
+  }
+};
+
 /// `searches` with the next of each one judged_as_candidates raised to the
 /// best score of the candidates not at its best pose's place, where one
 /// scores more: the same measure on the same occupancy, so that the search's
@@ -295,7 +306,6 @@ void bySecondLook(CandidateVerdict& v, const std::vector<Candidate>& candidates,
 /// 1.46x ahead of its own next but 1.09x of the features' candidate
 /// elsewhere, and corroborated it 9.0 m off (docs/results.md, "A search's
 /// lead over every candidate elsewhere").
-template <typename SamePose>
 std::vector<SearchLead> weighedAgainstCandidates(std::vector<SearchLead> searches,
                                                  const std::vector<Candidate>& candidates, const SamePose& samePose) {
   for (SearchLead& s : searches) {
@@ -380,9 +390,7 @@ CandidateVerdict decideOnCandidates(const DecisionEvidence& e, const MatchParams
   const std::vector<Candidate>& candidates = e.candidates;
   const Eigen::Vector2d& source_centre = e.source_centre;
   const ConsensusParams tolerance = consensusParams(params, e.grid);
-  const auto samePose = [&](const DensePose& a, const DensePose& b) {
-    return onePlace(a.transform, a.offset, b.transform, b.offset, tolerance, source_centre);
-  };
+  const SamePose samePose{tolerance, source_centre};
   const auto samePlace = [&](const Candidate& a, const Candidate& b) { return samePose(a.landed, b.landed); };
   CandidateVerdict v = decidePlace(candidates, params, tolerance, source_centre,
                                    weighedAgainstCandidates(e.searches, candidates, samePose), samePlace);
@@ -390,6 +398,10 @@ CandidateVerdict decideOnCandidates(const DecisionEvidence& e, const MatchParams
   if (v.answer >= 0 && v.on != CandidateVerdict::On::second_look)
     v.answer = static_cast<int>(finestAt(candidates, static_cast<size_t>(v.answer), samePlace));
   return v;
+}
+
+std::vector<SearchLead> weighedSearches(const DecisionEvidence& e, const MatchParams& params) {
+  return weighedAgainstCandidates(e.searches, e.candidates, SamePose{consensusParams(params, e.grid), e.source_centre});
 }
 
 }  // namespace tomomap

@@ -163,4 +163,9 @@ struct DecisionEvidence {
 /// best of that and every candidate not at its best pose's place.
 CandidateVerdict decideOnCandidates(const DecisionEvidence& e, const MatchParams& params);
 
+/// e.searches as decideOnCandidates weighs them: the next of each one
+/// judged_as_candidates raised to the best candidate not at its best pose's
+/// place, where one scores more. What a result reports as a search's lead.
+std::vector<SearchLead> weighedSearches(const DecisionEvidence& e, const MatchParams& params);
+
 }  // namespace tomomap

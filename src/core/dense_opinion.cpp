@@ -4,7 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <stdexcept>
-#include <tuple>
+#include <utility>
 
 #include "dense_refine.hpp"
 #include "height_offsets.hpp"
@@ -131,18 +131,22 @@ CandidateVerdict decide(MatchResult& r, const FeatureProposals& f, const std::op
   DecisionEvidence e;
   e.grid = target.grid;
   e.source_centre = source.occupancy.grid.centre();
-  for (const auto& [o, from, lead] : {std::tuple{&at_grid, Candidate::From::search_at_grid, &r.dense.at_grid_lead},
-                                      std::tuple{&wide, Candidate::From::search_wide, &r.dense.wide_lead},
-                                      std::tuple{&at_pooled, Candidate::From::search_pooled, &r.dense.pooled_lead}}) {
+  for (const auto& [o, from] :
+       {std::pair{&at_grid, Candidate::From::search_at_grid}, std::pair{&wide, Candidate::From::search_wide},
+        std::pair{&at_pooled, Candidate::From::search_pooled}}) {
     if (!*o) continue;
     for (size_t i = 0; i < (*o)->search.poses.size() && i < kProposalsPerSearch; ++i)
       proposals.push_back(
           {from, static_cast<int>(i), 0, (*o)->search.poses[i].transform, (*o)->search.poses[i].offset});
-    if (!(*o)->found()) continue;
-    e.searches.push_back({from, evidenceOf(**o), (*o)->pooling, {}, from == Candidate::From::search_wide});
-    *lead = e.searches.back().found.lead();
+    if ((*o)->found())
+      e.searches.push_back({from, evidenceOf(**o), (*o)->pooling, {}, from == Candidate::From::search_wide});
   }
   if (!proposals.empty()) e.candidates = refineAndLand(land(), target, source, proposals, params, f.votes);
+  // Each search's lead as the decision weighs it.
+  for (const SearchLead& l : weighedSearches(e, params))
+    (l.from == Candidate::From::search_wide     ? r.dense.wide_lead
+     : l.from == Candidate::From::search_pooled ? r.dense.pooled_lead
+                                                : r.dense.at_grid_lead) = l.found.lead();
   CandidateVerdict v;
   // The decision asks for the second look of a search on the maps' own
   // cells (at the grid, pooled: those ran on the full slices), one at a time.

@@ -4,6 +4,6 @@
 // a field changes meaning or goes away; a new field does not raise it.
 namespace tomomap {
 
-constexpr int kJsonSchemaVersion = 5;
+constexpr int kJsonSchemaVersion = 6;
 
 }  // namespace tomomap
