@@ -27,6 +27,23 @@ int coarsening(const SliceStack& s, int side) {
   return std::max(1, (longest + side - 1) / side);
 }
 
+/// A correlation's peak: its largest whole count of coincident cells, and
+/// the first shift, in the raster's order, at that count. A shift's value
+/// is that count times `scale`, up to the transforms' rounding
+/// (thousandths): on sparse crops many shifts tie at the largest count, and
+/// which one a search keeps is then not a matter of how the transforms
+/// round. The largest value is a reduction the compiler vectorises
+/// (std::max_element steps one value at a time).
+std::pair<double, size_t> peakOf(const RealImage& corr, double scale) {
+  float largest = -std::numeric_limits<float>::infinity();
+#pragma omp simd reduction(max : largest)
+  for (size_t i = 0; i < corr.size(); ++i) largest = corr[i] > largest ? corr[i] : largest;
+  const double most = std::round(scale * largest);
+  const auto least = static_cast<float>((most - 0.5) / scale);
+  const auto top = std::find_if(corr.begin(), corr.end(), [least](float v) { return v >= least; });
+  return {most, static_cast<size_t>(top - corr.begin())};
+}
+
 /// The best shift at one (yaw, coarse height offset).
 struct Peak {
   double score = 0;
@@ -153,15 +170,7 @@ DenseSearch searchDensely(const PoseLander& land, const ConsensusParams& same, c
             const size_t at = static_cast<size_t>(dz + zs - 1);
             if (!summed[at]) continue;
             fft.inverse(sums[at], corr);
-            // A shift's value counts coincident cells: a whole number, up to
-            // the transforms' rounding (thousandths). The peak is the first
-            // shift, in the raster's order, at the largest whole count: on
-            // sparse crops many shifts tie there, and which one a search
-            // keeps is then not a matter of how the transforms round.
-            const double most = std::round(scale * *std::max_element(corr.begin(), corr.end()));
-            const auto least = static_cast<float>((most - 0.5) / scale);
-            const size_t top = static_cast<size_t>(
-                std::find_if(corr.begin(), corr.end(), [least](float v) { return v >= least; }) - corr.begin());
+            const auto [most, top] = peakOf(corr, scale);
             const int x = static_cast<int>(top % static_cast<size_t>(fft.cols())),
                       y = static_cast<int>(top / static_cast<size_t>(fft.cols()));
             const int dx = x < xt ? x : x - fft.cols(), dy = y < yt ? y : y - fft.rows();
