@@ -46,9 +46,10 @@ DensePose climb(const PoseLander& land, const SliceGrid& source, double cell, co
   int offset = from.offset;
   double score = from.score();
   bool moved = false;
+  PoseLander::Memo memo;  // a step in height scores the same transforms again
   for (int step = 0; step < kMaxSteps; ++step) {
     const PoseLander::Poses steps = stepsFrom(T, offset, cell, yaw_step, source.centre());
-    const std::vector<double> scores = land.scores(steps);
+    const std::vector<double> scores = land.scores(steps, &memo);
     const size_t next = best(scores);
     if (scores[next] <= score) break;
     T = steps[next].first, offset = steps[next].second, score = scores[next], moved = true;

@@ -5,7 +5,6 @@
 #include <map>
 #include <mutex>
 #include <optional>
-#include <tuple>
 
 #include "pose_judge.hpp"
 
@@ -24,19 +23,22 @@ int mostInliersNear(const Columns& dilated, const std::vector<Cell>& cells, cons
   return mostInliersAt(dilated, cells, landings(cells, T, grid), middle - reach, 2 * reach + 1, middle);
 }
 
-/// `poses` by transform: the indices of the poses of each distinct one, told
-/// apart by their bits (so that -0.0 and a NaN are transforms of their own).
-std::vector<std::vector<size_t>> byTransform(const PoseLander::Poses& poses) {
+/// A transform told apart by its bits (so that -0.0 and a NaN are transforms of their own).
+std::array<uint64_t, 3> bitsOf(const Rigid2D& T) {
   const auto bits = [](double x) {
     uint64_t b;
     std::memcpy(&b, &x, sizeof b);
     return b;
   };
-  std::map<std::tuple<uint64_t, uint64_t, uint64_t>, size_t> index;
+  return {bits(T.yaw), bits(T.t.x()), bits(T.t.y())};
+}
+
+/// `poses` by transform: the indices of the poses of each distinct one (bitsOf).
+std::vector<std::vector<size_t>> byTransform(const PoseLander::Poses& poses) {
+  std::map<std::array<uint64_t, 3>, size_t> index;
   std::vector<std::vector<size_t>> out;
   for (size_t n = 0; n < poses.size(); ++n) {
-    const Rigid2D& T = poses[n].first;
-    const auto [at, added] = index.try_emplace({bits(T.yaw), bits(T.t.x()), bits(T.t.y())}, out.size());
+    const auto [at, added] = index.try_emplace(bitsOf(poses[n].first), out.size());
     if (added) out.emplace_back();
     out[at->second].push_back(n);
   }
@@ -93,12 +95,40 @@ std::vector<DensePose> PoseLander::operator()(const Poses& poses) const {
   return out;
 }
 
-std::vector<double> PoseLander::scores(const Poses& poses) const {
+std::vector<double> PoseLander::scores(const Poses& poses, Memo* memo) const {
+  Memo own;
+  Memo& m = memo ? *memo : own;
   std::vector<double> out(poses.size());
-  forEachLanding(*judge_, poses, judge_->source_telling, judge_->target_telling, threads_,
-                 [&](size_t n, const std::vector<int>& forth, const std::vector<int>& back) {
-                   out[n] = judge_->score(poses[n].first, poses[n].second, forth, back);
-                 });
+  // The poses it has not counted, by transform; each transform's landings
+  // from the memo where the last call made them.
+  Poses pending;
+  std::vector<size_t> at;  // each pending pose's index in `poses`
+  for (size_t n = 0; n < poses.size(); ++n)
+    if (const auto known = m.scored_.find({bitsOf(poses[n].first), poses[n].second}); known != m.scored_.end())
+      out[n] = known->second;
+    else
+      pending.push_back(poses[n]), at.push_back(n);
+  const std::vector<std::vector<size_t>> groups = byTransform(pending);
+  std::vector<std::shared_ptr<const Memo::Landed>> landed(groups.size());
+#pragma omp parallel for schedule(dynamic) num_threads(threads_)
+  for (size_t g = 0; g < groups.size(); ++g) {
+    const Rigid2D& T = pending[groups[g].front()].first;
+    if (const auto made = m.landed_.find(bitsOf(T)); made != m.landed_.end())
+      landed[g] = made->second;
+    else
+      landed[g] =
+          std::make_shared<const Memo::Landed>(landings(judge_->source_telling, T, judge_->target.grid),
+                                               landings(judge_->target_telling, T.inverse(), judge_->source.grid));
+    for (size_t k : groups[g]) out[at[k]] = judge_->score(T, pending[k].second, landed[g]->first, landed[g]->second);
+  }
+  // Kept: every count, and the landings of this call's transforms alone.
+  std::map<Memo::Key, std::shared_ptr<const Memo::Landed>> kept;
+  for (size_t g = 0; g < groups.size(); ++g) kept.emplace(bitsOf(pending[groups[g].front()].first), landed[g]);
+  for (const auto& [T, offset] : poses)
+    if (const auto made = m.landed_.find(bitsOf(T)); made != m.landed_.end()) kept.emplace(made->first, made->second);
+  m.landed_ = std::move(kept);
+  for (size_t k = 0; k < pending.size(); ++k)
+    m.scored_.emplace(std::pair{bitsOf(pending[k].first), pending[k].second}, out[at[k]]);
   return out;
 }
 

@@ -2,6 +2,9 @@
 // The two maps' occupancy prepared once, and poses landed on it: how every
 // pose a match weighs is judged (a candidate, a climb's step, a search's best
 // pose), on one measure, DensePose::score().
+#include <array>
+#include <cstdint>
+#include <map>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -63,10 +66,24 @@ class PoseLander {
   PoseLander(const SliceStack& target, const SliceStack& source, const DenseSearchParams& params = {});
   /// Each pose landed (landPose).
   std::vector<DensePose> operator()(const Poses& poses) const;
+  /// What scores() counted and landed, kept for a caller that scores poses
+  /// near those it scored last (a climb, nearby_poses.hpp: a step in height
+  /// scores the same transforms again, and two thirds of the same poses).
+  /// A pose is counted once, and the transforms of the last call are landed
+  /// once: it holds their landings alone, a few MB.
+  class Memo {
+    friend class PoseLander;
+    using Key = std::array<uint64_t, 3>;                           ///< a transform's bits: yaw, x, y
+    using Landed = std::pair<std::vector<int>, std::vector<int>>;  ///< telling cells forth and back
+    std::map<std::pair<Key, int>, double> scored_;
+    std::map<Key, std::shared_ptr<const Landed>> landed_;
+  };
   /// Each pose's DensePose::score() alone, counted on the telling cells alone
   /// (the only ones it weighs): for a caller that ranks many poses and lands
-  /// only the best (a climb, nearby_poses.hpp).
-  std::vector<double> scores(const Poses& poses) const;
+  /// only the best (a climb, nearby_poses.hpp). With `memo`, what it holds
+  /// of these poses is taken from it, and what it counts kept in it: the
+  /// same scores to the bit.
+  std::vector<double> scores(const Poses& poses, Memo* memo = nullptr) const;
   /// Each pose landed slice by slice (landSlices).
   std::vector<std::vector<SliceLanding>> slices(const Poses& poses) const;
   /// occupancyHeightOffset on the occupancy prepared.
