@@ -295,11 +295,9 @@ struct SamePose {
   }
 };
 
-/// `searches` with the next of each one judged_as_candidates raised to the
-/// best score of the candidates not at its best pose's place, where one
-/// scores more: the same measure on the same occupancy, so that the search's
-/// lead is over every pose proposed elsewhere and not only over the few it
-/// kept. Which coarse poses it keeps hangs on ties: on a sparse crop many
+/// `searches` weighed against `candidates` (weighedSearches). Why over every
+/// pose proposed elsewhere and not only the few the search kept: which
+/// coarse poses it keeps hangs on ties: on a sparse crop many
 /// shifts reach a peak's count, and the one kept is a matter of how the
 /// correlation rounds. On a LiDAR crop (unseen kitti-lidar-324 at g 0.2), a
 /// rounding that dropped the one pose near the best (1.01x) left the best

@@ -121,8 +121,7 @@ struct SearchLead {
   int pooling = 1;      ///< the maps' slices per slice it searched: its height is that coarse
   std::optional<SecondLook> look;
   /// It judged its poses on the occupancy the candidates are landed on (the
-  /// wide search): its next is then also every candidate elsewhere
-  /// (decideOnCandidates).
+  /// wide search): what that changes, weighedSearches.
   bool judged_as_candidates = false;
 };
 
@@ -159,13 +158,15 @@ struct DecisionEvidence {
 /// so, and that search's second look finds it again (asked for by
 /// needs_look). At the place the first three answer, the pose answered is
 /// the candidate there that lands the most on the maps' own cells, unpooled.
-/// A search's next is its own next pose; for one judged_as_candidates, the
-/// best of that and every candidate not at its best pose's place.
+/// The searches are weighed as weighedSearches weighs them.
 CandidateVerdict decideOnCandidates(const DecisionEvidence& e, const MatchParams& params);
 
-/// e.searches as decideOnCandidates weighs them: the next of each one
-/// judged_as_candidates raised to the best candidate not at its best pose's
-/// place, where one scores more. What a result reports as a search's lead.
+/// e.searches as decideOnCandidates weighs them. A search's next is its own
+/// next pose; for one judged_as_candidates, the best of that and every
+/// candidate not at its best pose's place: the same measure on the same
+/// occupancy, so its lead is over every pose proposed elsewhere (a lead
+/// below 1 where one of them scores more). What a result reports as a
+/// search's lead.
 std::vector<SearchLead> weighedSearches(const DecisionEvidence& e, const MatchParams& params);
 
 }  // namespace tomomap

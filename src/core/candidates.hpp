@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "pose_lander.hpp"
 #include "features.hpp"
 #include "match_params.hpp"
+#include "pose_lander.hpp"
 
 namespace tomomap {
 
@@ -59,7 +59,7 @@ struct Proposal {
 };
 
 /// Every proposal landed on the maps' occupancy as the dense search lands its
-/// poses (dense_search.hpp); the kMostRefined best distinct places are
+/// poses (pose_lander.hpp); the kMostRefined best distinct places are
 /// refined: uphill (nearby_poses.hpp) on maps small enough for a dense
 /// search, by one ICP on the occupancy (dense_refine.hpp) on larger ones.
 /// Then every one takes the occupancy's height within half the smear of its

@@ -9,6 +9,7 @@
 
 #include "bit_raster.hpp"
 #include "dense_refine.hpp"
+#include "match_params.hpp"
 #include "pose_judge.hpp"
 #include "pose_lander.hpp"
 #include "spectrum_correlation.hpp"
@@ -52,7 +53,11 @@ struct Peak {
 
 }  // namespace
 
-using namespace dense_detail;
+using dense_detail::Cell;
+using dense_detail::columnsOf;
+using dense_detail::landings;
+using dense_detail::mostInliersAt;
+using dense_detail::PoseJudge;
 
 DenseSearchParams denseSearchParams(const MatchParams& params, DenseSearchParams dp) {
   dp.threads = matchThreads(params);

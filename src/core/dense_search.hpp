@@ -4,11 +4,12 @@
 #include <vector>
 
 #include "consensus.hpp"
-#include "match_params.hpp"
 #include "rigid2d.hpp"
 #include "slices.hpp"
 
 namespace tomomap {
+
+struct MatchParams;  // match_params.hpp
 
 struct DenseSearchParams {
   /// The coarse raster has at most this many cells along each axis; the

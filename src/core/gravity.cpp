@@ -47,8 +47,9 @@ struct Patch {
 };
 
 /// The points of a map one measurement reads, read where they lie rather
-/// than copied (copies of a sample and its parts took 26 MB a map, and their
-/// pages' faults were among the slowest matrix pair's costs): every
+/// than copied (a sample, its turned copy and its parts' copies took 26 MB a
+/// map beside the voxel filter's buffers, and their pages' faults were among
+/// the slowest matrix pair's costs): every
 /// `stride`-th point, and of those, for a half, the ones on one side of
 /// `cut` along `along`.
 struct Part {
@@ -74,8 +75,6 @@ Eigen::Vector3f turnedBy(const Eigen::Matrix3f& turn, const Eigen::Vector3f& p) 
 }
 
 /// The points of `part` of `map`, turned by `turn`, binned in cubes of `side`.
-/// The points are read where they lie, not copied: a sample of a large map,
-/// and its turned copy, would sit beside the voxel filter's buffers.
 std::vector<Patch> flatPatches(const Points& map, const Part& part, const Eigen::Matrix3f& turn, double side) {
   struct Sums {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -246,9 +245,10 @@ std::vector<Part> partsOf(const Points& map) {
 
 }  // namespace
 
-Tilt estimateTilt(const Points& map, double grid, double matched_within) {
+Tilt estimateTilt(const Points& map, double grid, std::optional<double> matched_within) {
   Tilt t = measureTilt(map, grid, sampleOf(map));
-  if (!t.measured || t.angle <= matched_within) return t;
+  if (!t.measured || (matched_within && t.angle <= *matched_within)) return t;
+  t.checked = true;
   // A standard error counts the patches as independent; they are not (a
   // road that slopes, one wall that leans): on the real scans, halves of a
   // map read 0.5-2.5 deg from the whole with standard errors of 0.1-0.3. The
@@ -299,7 +299,9 @@ bool levelableUp(const Eigen::Vector3d& up) {
 }
 
 std::string leanText(const Tilt& t) {
-  return fixed(degrees(t.angle), 1) + " +- " + fixed(degrees(t.uncertainty), 1) + " deg from gravity (" +
+  const bool stated = t.checked || t.cue == Tilt::Cue::given;  // else only a standard error, not an uncertainty
+  return fixed(degrees(t.angle), 1) + (stated ? " +- " + fixed(degrees(t.uncertainty), 1) : std::string()) +
+         " deg from gravity (" +
          (t.cue == Tilt::Cue::given    ? "as given"
           : t.cue == Tilt::Cue::floors ? "read off its floors"
                                        : "read off its walls") +

@@ -3,6 +3,7 @@
 // maps; map files from LiDAR odometry (KISS-ICP, FAST-LIO) sit in the first
 // sensor or IMU frame and are tilted whenever that was.
 #include <Eigen/Geometry>
+#include <optional>
 #include <string>
 
 #include "types.hpp"
@@ -16,9 +17,12 @@ struct Tilt {
   /// How far `up` may be off [rad]: the farthest the same estimate reads on
   /// parts of the map that can check it (fairPart: its halves, a third and a
   /// tenth of its points) plus the cue's standard error; at least `angle`
-  /// where most parts cannot check it (the lean is then not known better than it is).
-  /// The standard error alone where the parts were not measured (estimateTilt).
+  /// where most parts cannot check it (the lean is then not known better than
+  /// it is). The cue's standard error alone where the parts were not measured.
   double uncertainty = 0;
+  /// Whether the parts were measured (estimateTilt measures them only where a
+  /// decision reads the uncertainty they give).
+  bool checked = false;
   /// What `up` was read from: floors (and ground, ceilings), or walls where
   /// there are too few floors; or given by the user (an IMU's or the SLAM's
   /// own gravity), then exact.
@@ -64,11 +68,10 @@ bool levelableUp(const Eigen::Vector3d& up);
 /// walls' normals avoid where there are too few floors; found from z in a few
 /// rounds, then again in the frame levelled so far. On sloping ground it reads
 /// the slope. Its uncertainty is measured on the map's parts (Tilt::uncertainty),
-/// where it may matter: a map leaning no more than `matched_within` is
-/// matched as it is whatever its uncertainty (MatchParams::max_tilt), and
-/// its uncertainty is then the cue's standard error alone. The parts took
-/// 0.23 of the estimate's 0.25 s on a 1 M-point room of the matrix.
-Tilt estimateTilt(const Points& map, double grid, double matched_within = 0);
+/// where it may matter: a map leaning no more than `matched_within`, where
+/// given, is matched as it is whatever its uncertainty (MatchParams::max_tilt),
+/// and its parts, most of the estimate's time, are not measured (Tilt::checked).
+Tilt estimateTilt(const Points& map, double grid, std::optional<double> matched_within = std::nullopt);
 
 /// A part of a map (a crop, a thinning) checks the whole's estimate where it
 /// is read off the same cue and holds at least this share of the whole's

@@ -52,8 +52,8 @@ struct FeatureFindings {
 
 /// What the dense searches of small maps found (dense_opinion.hpp), each
 /// search's best pose over its next in DensePose::score (dense_search.hpp),
-/// as the decision weighs it (weighedSearches: the wide search's next is also
-/// every candidate elsewhere); 0 where that search did not run or found nothing.
+/// as the decision weighs it (weighedSearches); 0 where that search did not
+/// run or found nothing.
 struct DenseFindings {
   double at_grid_lead = 0;  ///< the search on the maps' own cells, full slices
   double wide_lead = 0;     ///< the search on a raster twice as fine (kWideCoarseSide)

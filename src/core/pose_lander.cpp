@@ -10,7 +10,14 @@
 
 namespace tomomap {
 
-using namespace dense_detail;
+using dense_detail::Cell;
+using dense_detail::cellsOf;
+using dense_detail::columnsOf;
+using dense_detail::dilatedSlices;
+using dense_detail::landings;
+using dense_detail::mostInliersAt;
+using dense_detail::PoseJudge;
+using dense_detail::SliceWindows;
 
 namespace {
 
@@ -24,7 +31,7 @@ int mostInliersNear(const Columns& dilated, const std::vector<Cell>& cells, cons
 }
 
 /// A transform told apart by its bits (so that -0.0 and a NaN are transforms of their own).
-std::array<uint64_t, 3> bitsOf(const Rigid2D& T) {
+std::array<uint64_t, 3> transformBits(const Rigid2D& T) {
   const auto bits = [](double x) {
     uint64_t b;
     std::memcpy(&b, &x, sizeof b);
@@ -33,12 +40,12 @@ std::array<uint64_t, 3> bitsOf(const Rigid2D& T) {
   return {bits(T.yaw), bits(T.t.x()), bits(T.t.y())};
 }
 
-/// `poses` by transform: the indices of the poses of each distinct one (bitsOf).
+/// `poses` by transform: the indices of the poses of each distinct one (transformBits).
 std::vector<std::vector<size_t>> byTransform(const PoseLander::Poses& poses) {
   std::map<std::array<uint64_t, 3>, size_t> index;
   std::vector<std::vector<size_t>> out;
   for (size_t n = 0; n < poses.size(); ++n) {
-    const auto [at, added] = index.try_emplace(bitsOf(poses[n].first), out.size());
+    const auto [at, added] = index.try_emplace(transformBits(poses[n].first), out.size());
     if (added) out.emplace_back();
     out[at->second].push_back(n);
   }
@@ -98,13 +105,14 @@ std::vector<DensePose> PoseLander::operator()(const Poses& poses) const {
 std::vector<double> PoseLander::scores(const Poses& poses, Memo* memo) const {
   Memo own;
   Memo& m = memo ? *memo : own;
+  if (m.of_ != judge_.get()) m = Memo{}, m.of_ = judge_.get();
   std::vector<double> out(poses.size());
   // The poses it has not counted, by transform; each transform's landings
   // from the memo where the last call made them.
   Poses pending;
   std::vector<size_t> at;  // each pending pose's index in `poses`
   for (size_t n = 0; n < poses.size(); ++n)
-    if (const auto known = m.scored_.find({bitsOf(poses[n].first), poses[n].second}); known != m.scored_.end())
+    if (const auto known = m.scored_.find({transformBits(poses[n].first), poses[n].second}); known != m.scored_.end())
       out[n] = known->second;
     else
       pending.push_back(poses[n]), at.push_back(n);
@@ -113,7 +121,7 @@ std::vector<double> PoseLander::scores(const Poses& poses, Memo* memo) const {
 #pragma omp parallel for schedule(dynamic) num_threads(threads_)
   for (size_t g = 0; g < groups.size(); ++g) {
     const Rigid2D& T = pending[groups[g].front()].first;
-    if (const auto made = m.landed_.find(bitsOf(T)); made != m.landed_.end())
+    if (const auto made = m.landed_.find(transformBits(T)); made != m.landed_.end())
       landed[g] = made->second;
     else
       landed[g] =
@@ -121,14 +129,16 @@ std::vector<double> PoseLander::scores(const Poses& poses, Memo* memo) const {
                                                landings(judge_->target_telling, T.inverse(), judge_->source.grid));
     for (size_t k : groups[g]) out[at[k]] = judge_->score(T, pending[k].second, landed[g]->first, landed[g]->second);
   }
+  if (!memo) return out;
   // Kept: every count, and the landings of this call's transforms alone.
   std::map<Memo::Key, std::shared_ptr<const Memo::Landed>> kept;
-  for (size_t g = 0; g < groups.size(); ++g) kept.emplace(bitsOf(pending[groups[g].front()].first), landed[g]);
+  for (size_t g = 0; g < groups.size(); ++g) kept.emplace(transformBits(pending[groups[g].front()].first), landed[g]);
   for (const auto& [T, offset] : poses)
-    if (const auto made = m.landed_.find(bitsOf(T)); made != m.landed_.end()) kept.emplace(made->first, made->second);
+    if (const auto made = m.landed_.find(transformBits(T)); made != m.landed_.end())
+      kept.emplace(made->first, made->second);
   m.landed_ = std::move(kept);
   for (size_t k = 0; k < pending.size(); ++k)
-    m.scored_.emplace(std::pair{bitsOf(pending[k].first), pending[k].second}, out[at[k]]);
+    m.scored_.emplace(std::pair{transformBits(pending[k].first), pending[k].second}, out[at[k]]);
   return out;
 }
 

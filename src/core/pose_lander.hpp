@@ -75,6 +75,7 @@ class PoseLander {
     friend class PoseLander;
     using Key = std::array<uint64_t, 3>;                           ///< a transform's bits: yaw, x, y
     using Landed = std::pair<std::vector<int>, std::vector<int>>;  ///< telling cells forth and back
+    const void* of_ = nullptr;  ///< the judge whose counts it holds: a memo handed to another lander starts empty
     std::map<std::pair<Key, int>, double> scored_;
     std::map<Key, std::shared_ptr<const Landed>> landed_;
   };

@@ -7,9 +7,9 @@
 #include "core/candidates.hpp"
 #include "core/dense_refine.hpp"
 #include "core/dense_search.hpp"
-#include "core/pose_lander.hpp"
 #include "core/matcher.hpp"
 #include "core/nearby_poses.hpp"
+#include "core/pose_lander.hpp"
 #include "core/voxel_filter.hpp"
 #include "synth/synth.hpp"
 
@@ -271,6 +271,40 @@ TEST(DenseSearch, APosesSlicesAddUpToItsTallies) {
   EXPECT_EQ(holding_seen, pose.support_seen);
   EXPECT_GT(pose.support, 0);
   EXPECT_LT(pose.support, room.size());
+}
+
+// A climb keeps what it counted and landed in a memo: a step in height asks
+// again for the same transforms and most of the same poses. Through the memo
+// the scores are the same to the bit as counted afresh, whatever the memo
+// held before; a memo handed to another lander starts over.
+TEST(DenseSearch, ScoresThroughAMemoAreTheScoresCountedAfresh) {
+  const SliceStack room = stackOf(roomScan());
+  DenseSearchParams two_threads;
+  two_threads.threads = 2;
+  const PoseLander land(room, room, two_threads);
+  const auto ring = [](const Rigid2D& T, int offset) {
+    PoseLander::Poses out;
+    for (int o = offset - 1; o <= offset + 1; ++o)
+      for (const Rigid2D& step : {T, Rigid2D{T.yaw, T.t + Eigen::Vector2d(0.1, 0)}, Rigid2D{T.yaw + 0.01, T.t}})
+        out.emplace_back(step, o);
+    return out;
+  };
+  const Rigid2D T{radians(4), {0.4, -0.3}};
+  PoseLander::Memo memo;
+  // The same transforms a height up, then down again (every pose known), then elsewhere.
+  for (const PoseLander::Poses& poses : {ring(T, 0), ring(T, 1), ring(T, 0), ring(Rigid2D{}, 0)}) {
+    const std::vector<double> remembered = land.scores(poses, &memo), afresh = land.scores(poses);
+    ASSERT_EQ(remembered.size(), poses.size());
+    for (size_t n = 0; n < poses.size(); ++n) EXPECT_EQ(remembered[n], afresh[n]) << n;
+  }
+  // Another lander of other maps: the memo's counts are not its own.
+  SliceStack moved = room;
+  moved.cells.erase(moved.cells.begin());
+  const PoseLander other(room, moved, two_threads);
+  const PoseLander::Poses poses = ring(T, 0);
+  const std::vector<double> there = other.scores(poses, &memo), afresh = other.scores(poses);
+  for (size_t n = 0; n < poses.size(); ++n) EXPECT_EQ(there[n], afresh[n]) << n;
+  EXPECT_NE(there, land.scores(poses));  // not the first lander's counts
 }
 
 // A climb ranks its steps by score alone, counted on the telling cells alone,
