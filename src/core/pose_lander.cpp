@@ -52,22 +52,31 @@ std::vector<std::vector<size_t>> byTransform(const PoseLander::Poses& poses) {
   return out;
 }
 
-/// Calls f(n, forth, back) for each of `poses` with where its transform lands
-/// `forth_cells` on the target and `back_cells` on the source: landed once
-/// per distinct transform (a climb's steps and a ring of shifts land each at
-/// several heights, and where a transform lands the cells does not depend on
-/// the height), the transforms spread over `threads`.
-template <typename F>
-void forEachLanding(const PoseJudge& judge, const PoseLander::Poses& poses, const std::vector<Cell>& forth_cells,
-                    const std::vector<Cell>& back_cells, int threads, const F& f) {
+/// Where transform `T` lands `forth_cells` on the target and `back_cells` on the source.
+std::shared_ptr<const PoseLander::Memo::Landed> landedBy(const PoseJudge& judge, const Rigid2D& T,
+                                                         const std::vector<Cell>& forth_cells,
+                                                         const std::vector<Cell>& back_cells) {
+  return std::make_shared<const PoseLander::Memo::Landed>(landings(forth_cells, T, judge.target.grid),
+                                                          landings(back_cells, T.inverse(), judge.source.grid));
+}
+
+/// Calls f(n, landed) for each of `poses` with `land(T)`, where its transform
+/// lands the cells (landedBy): landed once per distinct transform (a climb's
+/// steps and a ring of shifts land each at several heights, and where a
+/// transform lands the cells does not depend on the height), the transforms
+/// spread over `threads`. Returns each distinct transform with its landing.
+template <typename Land, typename F>
+std::vector<std::pair<Rigid2D, std::shared_ptr<const PoseLander::Memo::Landed>>> forEachLanding(
+    const PoseLander::Poses& poses, int threads, const Land& land, const F& f) {
   const std::vector<std::vector<size_t>> groups = byTransform(poses);
+  std::vector<std::pair<Rigid2D, std::shared_ptr<const PoseLander::Memo::Landed>>> landed(groups.size());
 #pragma omp parallel for schedule(dynamic) num_threads(threads)
   for (size_t g = 0; g < groups.size(); ++g) {
     const Rigid2D& T = poses[groups[g].front()].first;
-    const std::vector<int> forth = landings(forth_cells, T, judge.target.grid),
-                           back = landings(back_cells, T.inverse(), judge.source.grid);
-    for (size_t n : groups[g]) f(n, forth, back);
+    landed[g] = {T, land(T)};
+    for (size_t n : groups[g]) f(n, *landed[g].second);
   }
+  return landed;
 }
 
 }  // namespace
@@ -93,12 +102,14 @@ PoseLander::PoseLander(const SliceStack& target, const SliceStack& source, const
 
 std::vector<DensePose> PoseLander::operator()(const Poses& poses) const {
   std::vector<DensePose> out(poses.size());
-  forEachLanding(*judge_, poses, judge_->source_cells, judge_->target_cells, threads_,
-                 [&](size_t n, const std::vector<int>& forth, const std::vector<int>& back) {
-                   DensePose& p = out[n];
-                   p.transform = poses[n].first, p.offset = poses[n].second;
-                   PoseJudge::judge(p, judge_->forth(forth, p.offset), judge_->backwards(back, p.offset));
-                 });
+  forEachLanding(
+      poses, threads_,
+      [&](const Rigid2D& T) { return landedBy(*judge_, T, judge_->source_cells, judge_->target_cells); },
+      [&](size_t n, const Memo::Landed& landed) {
+        DensePose& p = out[n];
+        p.transform = poses[n].first, p.offset = poses[n].second;
+        PoseJudge::judge(p, judge_->forth(landed.first, p.offset), judge_->backwards(landed.second, p.offset));
+      });
   return out;
 }
 
@@ -116,23 +127,20 @@ std::vector<double> PoseLander::scores(const Poses& poses, Memo* memo) const {
       out[n] = known->second;
     else
       pending.push_back(poses[n]), at.push_back(n);
-  const std::vector<std::vector<size_t>> groups = byTransform(pending);
-  std::vector<std::shared_ptr<const Memo::Landed>> landed(groups.size());
-#pragma omp parallel for schedule(dynamic) num_threads(threads_)
-  for (size_t g = 0; g < groups.size(); ++g) {
-    const Rigid2D& T = pending[groups[g].front()].first;
-    if (const auto made = m.landed_.find(transformBits(T)); made != m.landed_.end())
-      landed[g] = made->second;
-    else
-      landed[g] =
-          std::make_shared<const Memo::Landed>(landings(judge_->source_telling, T, judge_->target.grid),
-                                               landings(judge_->target_telling, T.inverse(), judge_->source.grid));
-    for (size_t k : groups[g]) out[at[k]] = judge_->score(T, pending[k].second, landed[g]->first, landed[g]->second);
-  }
+  const auto landed = forEachLanding(
+      pending, threads_,
+      [&](const Rigid2D& T) {
+        const auto made = m.landed_.find(transformBits(T));
+        return made != m.landed_.end() ? made->second
+                                       : landedBy(*judge_, T, judge_->source_telling, judge_->target_telling);
+      },
+      [&](size_t k, const Memo::Landed& l) {
+        out[at[k]] = judge_->score(pending[k].first, pending[k].second, l.first, l.second);
+      });
   if (!memo) return out;
   // Kept: every count, and the landings of this call's transforms alone.
   std::map<Memo::Key, std::shared_ptr<const Memo::Landed>> kept;
-  for (size_t g = 0; g < groups.size(); ++g) kept.emplace(transformBits(pending[groups[g].front()].first), landed[g]);
+  for (const auto& [T, l] : landed) kept.emplace(transformBits(T), l);
   for (const auto& [T, offset] : poses)
     if (const auto made = m.landed_.find(transformBits(T)); made != m.landed_.end())
       kept.emplace(made->first, made->second);

@@ -72,9 +72,12 @@ class PoseLander {
   /// A pose is counted once, and the transforms of the last call are landed
   /// once: it holds their landings alone, a few MB.
   class Memo {
-    friend class PoseLander;
+   public:
     using Key = std::array<uint64_t, 3>;                           ///< a transform's bits: yaw, x, y
-    using Landed = std::pair<std::vector<int>, std::vector<int>>;  ///< telling cells forth and back
+    using Landed = std::pair<std::vector<int>, std::vector<int>>;  ///< where a transform lands cells forth and back
+
+   private:
+    friend class PoseLander;
     const void* of_ = nullptr;  ///< the judge whose counts it holds: a memo handed to another lander starts empty
     std::map<std::pair<Key, int>, double> scored_;
     std::map<Key, std::shared_ptr<const Landed>> landed_;
