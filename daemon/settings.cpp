@@ -128,9 +128,10 @@ std::vector<Setting> declare() {
   {
     Setting& s = d("map_up", K::Text, "X, Y, Z", Reload::AtOnce,
                    "the map's up direction in its own frame where it is known (its SLAM's gravity estimate, an "
-                   "IMU's), e.g. \"0.05, -0.02, 1\", within 30 deg of z: the map is levelled by it instead of by the "
-                   "estimate read off "
-                   "its floors (docs/operations.md, \"Maps that lean\")");
+                   "IMU's), e.g. \"0.05, -0.02, 1\", within " +
+                       fixed(degrees(kMaxLevelable), 0) +
+                       " deg of z: the map is levelled by it instead of by the estimate read off its floors "
+                       "(docs/operations.md, \"Maps that lean\")");
     s.default_text = "none: estimated";
     s.shown = [](const Config& c) { return c.map_up ? directionText(*c.map_up) : "(none: estimated)"; };
     s.check = [](const V& v) -> Check {

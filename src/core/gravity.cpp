@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <optional>
+#include <tuple>
 #include <unordered_map>
 
 #include "lattice.hpp"
@@ -18,18 +19,19 @@ namespace {
 constexpr double kPatchCells = 8.0;
 constexpr double kMinPatchSide = 0.4;  ///< [m]: below, voxel noise tilts the patches
 constexpr size_t kMinPatchPoints = 12;
+double cubeSide(double grid) { return std::max(kMinPatchSide, kPatchCells * grid); }
 /// Flat: the thinnest extent well below the other two (eigenvalues of the
 /// patch's covariance), and the patch not a line.
 constexpr double kFlatness = 0.05, kNotALine = 0.2;
-/// A normal within this of up is a floor's, within this of horizontal a
-/// wall's; the rest (stairs, clutter) says nothing.
-const double kClassCone = radians(30.0);
 constexpr int kRounds = 4;
 /// Fewer flat patches than this and a cue (floors, walls) says nothing.
-constexpr size_t kMinPatches = 20;
+constexpr size_t kMinPatches = kMinLines;
 /// Walls tell up only where they face two ways: the scatter's middle
 /// eigenvalue at least this share of its largest.
 constexpr double kTwoWays = 0.1;
+/// Patches whose normals lie within this of each other count as one
+/// direction's: a floor's patches scatter a few degrees (the hall's by 2-4).
+const double kModeCone = radians(10.0);
 /// A patch leaning off its kind's fit more than this many times the median is not of that kind.
 constexpr double kOutlierLeans = 3.0;
 /// Estimates, each in the frame the previous ones levelled (see estimateTilt).
@@ -74,19 +76,24 @@ Eigen::Vector3f turnedBy(const Eigen::Matrix3f& turn, const Eigen::Vector3f& p) 
   return {row(0), row(1), row(2)};
 }
 
-/// The points of `part` of `map`, turned by `turn`, binned in cubes of `side`.
-std::vector<Patch> flatPatches(const Points& map, const Part& part, const Eigen::Matrix3f& turn, double side) {
-  struct Sums {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-    size_t n = 0;
-  };
-  std::unordered_map<uint64_t, Sums> cubes;
+/// The points in one cube: their sums, enough for their covariance.
+struct Sums {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+  size_t n = 0;
+};
+using Cubes = std::unordered_map<uint64_t, Sums>;
+
+/// The points of `part` of `map`, turned by `turn`, binned in cubes of
+/// `side` on the lattice moved by `shift` along each axis.
+Cubes cubesOf(const Points& map, const Part& part, const Eigen::Matrix3f& turn, double side, float shift = 0) {
+  Cubes cubes;
   const bool turned = !turn.isIdentity(0.0f);
+  const Eigen::Vector3f moved = Eigen::Vector3f::Constant(shift);
   for (size_t i = 0; i < map.size(); i += part.stride) {
     if (!part.holds(map[i])) continue;
     const Eigen::Vector3f p = turned ? turnedBy(turn, map[i]) : map[i];
-    Sums& s = cubes[latticeKey(p, side)];
+    Sums& s = cubes[latticeKey(shift == 0 ? p : Eigen::Vector3f(p + moved), side)];
     const Eigen::Vector3d q = p.cast<double>();
     s.sum += q;
     // The upper triangle alone: the lower one is the same products.
@@ -94,20 +101,69 @@ std::vector<Patch> flatPatches(const Points& map, const Part& part, const Eigen:
       for (int c = r; c < 3; ++c) s.outer(r, c) += q(r) * q(c);
     ++s.n;
   }
+  return cubes;
+}
+
+/// How a cube's points spread: their covariance's eigenvalues (ascending)
+/// and directions; none for a cube of too few points to tell.
+std::optional<Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>> spreadOf(const Sums& s) {
+  if (s.n < kMinPatchPoints) return std::nullopt;
+  const double n = static_cast<double>(s.n);
+  const Eigen::Vector3d mean = s.sum / n;
+  const Eigen::Matrix3d outer = s.outer.selfadjointView<Eigen::Upper>();
+  const Eigen::Matrix3d cov = outer / n - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(cov);
+  return eig;
+}
+
+/// The flat cubes of `part` of `map` turned by `turn` (cubesOf) as patches.
+std::vector<Patch> flatPatches(const Points& map, const Part& part, const Eigen::Matrix3f& turn, double side) {
   std::vector<Patch> patches;
-  for (const auto& [k, s] : cubes) {
-    if (s.n < kMinPatchPoints) continue;
-    const double n = static_cast<double>(s.n);
-    const Eigen::Vector3d mean = s.sum / n;
-    const Eigen::Matrix3d outer = s.outer.selfadjointView<Eigen::Upper>();
-    const Eigen::Matrix3d cov = outer / n - mean * mean.transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(cov);
-    const Eigen::Vector3d l = eig.eigenvalues();  // ascending
+  for (const auto& [k, s] : cubesOf(map, part, turn, side)) {
+    const auto eig = spreadOf(s);
+    if (!eig) continue;
+    const Eigen::Vector3d l = eig->eigenvalues();  // ascending
     if (!(l(0) < kFlatness * l(1)) || !(l(1) > kNotALine * l(2))) continue;
-    patches.push_back({eig.eigenvectors().col(0).normalized(), n});
+    patches.push_back({eig->eigenvectors().col(0).normalized(), static_cast<double>(s.n)});
   }
   return patches;
+}
+
+/// The direction of a cube's points where they lie along a line (no plane's
+/// middle extent: kNotALine).
+std::optional<Eigen::Vector3d> lineOf(const Sums& s) {
+  const auto eig = spreadOf(s);
+  if (!eig) return std::nullopt;
+  const Eigen::Vector3d l = eig->eigenvalues();  // ascending
+  if (l(1) > kNotALine * l(2)) return std::nullopt;
+  return eig->eigenvectors().col(2).normalized();
+}
+
+/// The lines of `part` of `map` in the frame `turn` levels it into (posts,
+/// trunks, door frames, the corners where walls meet), and how many of them
+/// stand within kClassCone of z. A line counts where the lattice half a cube
+/// away sees it too, along the same direction: a plane cut near a cube's
+/// edge leaves a sliver that looks like a line in one lattice only (in a
+/// frame that turned the hall's walls off the lattice's axes, their slivers
+/// stood along z as much as its posts did).
+std::pair<size_t, size_t> standingLines(const Points& map, const Part& part, const Eigen::Matrix3f& turn, double side) {
+  const float half = 0.5f * static_cast<float>(side);
+  const Cubes cubes = cubesOf(map, part, turn, side), shifted = cubesOf(map, part, turn, side, half);
+  const Eigen::Vector3f to_shifted = Eigen::Vector3f::Constant(half);
+  size_t lines = 0, standing = 0;
+  for (const auto& [k, s] : cubes) {
+    const auto line = lineOf(s);
+    if (!line) continue;
+    const Eigen::Vector3f centre = (s.sum / static_cast<double>(s.n)).cast<float>();
+    const auto there = shifted.find(latticeKey(Eigen::Vector3f(centre + to_shifted), side));
+    if (there == shifted.end()) continue;
+    const auto again = lineOf(there->second);
+    if (!again || std::abs(again->dot(*line)) < std::cos(kClassCone)) continue;
+    ++lines;
+    standing += std::abs(line->z()) >= std::cos(kClassCone);
+  }
+  return {lines, standing};
 }
 
 /// One cue's up direction and how tightly its patches agree on it.
@@ -165,15 +221,14 @@ std::optional<Cue> fitUp(std::vector<Patch> patches, bool floors) {
 }
 
 /// Up from the patches, sorted into floors and walls by the up found so far
-/// (from z, in a few rounds): from the floors, or from the walls where there
-/// are too few floors. Floors are the gravity cue: in real maps walls lean a
-/// degree or three each way while floors lie level, and on vehicle LiDAR the
-/// walls' fit (cars, trees, poles) read 4-6 degrees where the road's plane
-/// fit read 1.5.
-std::optional<Cue> upOf(const std::vector<Patch>& patches, Tilt& t) {
+/// (from `up`, in a few rounds): from the floors, or from the walls where
+/// there are too few floors. Floors are the gravity cue: in real maps walls
+/// lean a degree or three each way while floors lie level, and on vehicle
+/// LiDAR the walls' fit (cars, trees, poles) read 4-6 degrees where the
+/// road's plane fit read 1.5.
+std::optional<Cue> upOf(const std::vector<Patch>& patches, Eigen::Vector3d up, Tilt& t) {
   const double floor_cos = std::cos(kClassCone), wall_cos = std::sin(kClassCone);
   std::optional<Cue> found;
-  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   for (int round = 0; round < kRounds; ++round) {
     std::vector<Patch> floors, walls;
     for (const auto& p : patches) {
@@ -198,6 +253,29 @@ std::optional<Cue> upOf(const std::vector<Patch>& patches, Tilt& t) {
   return found;
 }
 
+/// Up from the patches of a map whose floors lean beyond kClassCone, where
+/// the rounds from z find neither floors nor walls facing two ways: the
+/// rounds from the patches' densest normal between kClassCone and
+/// kMaxLevelable from z (the most patch weight within kModeCone of it),
+/// where they find an up beyond kClassCone (one nearer z the rounds from z
+/// would have found).
+std::optional<Cue> upBeyondTheCone(const std::vector<Patch>& patches, Tilt& t) {
+  const double cone_cos = std::cos(kClassCone), limit_cos = std::cos(kMaxLevelable), mode_cos = std::cos(kModeCone);
+  double most = 0;
+  std::optional<Eigen::Vector3d> densest;
+  for (const Patch& p : patches) {
+    const double c = std::abs(p.normal.z());
+    if (c >= cone_cos || c < limit_cos) continue;
+    double weight = 0;
+    for (const Patch& q : patches) weight += std::abs(p.normal.dot(q.normal)) >= mode_cos ? q.weight : 0.0;
+    if (weight > most) most = weight, densest = p.normal.z() < 0 ? Eigen::Vector3d(-p.normal) : p.normal;
+  }
+  if (!densest) return std::nullopt;
+  auto found = upOf(patches, *densest, t);
+  if (found && found->up.z() >= cone_cos) return std::nullopt;
+  return found;
+}
+
 /// The estimate itself (see estimateTilt): `up` from the flat patches of
 /// `part` of `map`, measured again in the frame levelled so far.
 Tilt measureTilt(const Points& map, double grid, const Part& part) {
@@ -206,10 +284,12 @@ Tilt measureTilt(const Points& map, double grid, const Part& part) {
   // again in the frame levelled so far, the cut runs along the floor.
   Tilt t;
   Eigen::Quaterniond leveling = Eigen::Quaterniond::Identity();
-  const double side = std::max(kMinPatchSide, kPatchCells * grid);
+  const double side = cubeSide(grid);
   for (int pass = 0; pass < kPasses; ++pass) {
     const Eigen::Matrix3f turn = leveling.toRotationMatrix().cast<float>();  // as rotatePoints turns
-    const auto cue = upOf(flatPatches(map, part, turn, side), t);
+    const std::vector<Patch> patches = flatPatches(map, part, turn, side);
+    auto cue = upOf(patches, Eigen::Vector3d::UnitZ(), t);
+    if (!cue && pass == 0) cue = upBeyondTheCone(patches, t);
     if (!cue) return t;
     leveling = Eigen::Quaterniond::FromTwoVectors(cue->up, Eigen::Vector3d::UnitZ()) * leveling;
     t.uncertainty = cue->error();
@@ -248,6 +328,12 @@ std::vector<Part> partsOf(const Points& map) {
 Tilt estimateTilt(const Points& map, double grid, std::optional<double> matched_within) {
   Tilt t = measureTilt(map, grid, sampleOf(map));
   if (!t.measured || (matched_within && t.angle <= *matched_within)) return t;
+  if (t.angle > kClassCone && t.angle <= kMaxLevelable) {
+    // In the frame the estimate levels the map into, where a lattice's cut
+    // runs along the floors (measureTilt).
+    const Eigen::Matrix3f turn = t.leveling().toRotationMatrix().cast<float>();
+    std::tie(t.lines, t.standing_lines) = standingLines(map, sampleOf(map), turn, cubeSide(grid));
+  }
   t.checked = true;
   // A standard error counts the patches as independent; they are not (a
   // road that slopes, one wall that leans): on the real scans, halves of a
@@ -306,6 +392,12 @@ std::string leanText(const Tilt& t) {
           : t.cue == Tilt::Cue::floors ? "read off its floors"
                                        : "read off its walls") +
          ")";
+}
+
+bool Tilt::linesStand() const { return lines >= kMinLines && 2 * standing_lines > lines; }
+
+bool Tilt::levelable() const {
+  return measured && uncertainty < angle && angle <= kMaxLevelable && (angle <= kClassCone || linesStand());
 }
 
 Eigen::Quaterniond Tilt::leveling() const { return levelingOf(up); }

@@ -29,10 +29,19 @@ struct Tilt {
   enum class Cue { floors, walls, given } cue = Cue::floors;
   size_t floor_patches = 0;  ///< flat patches facing up (floors, ceilings, ground)
   size_t wall_patches = 0;   ///< flat patches facing sideways (walls)
+  /// Read where the map leans beyond kClassCone (a wall may pass for a floor
+  /// there): its lines (posts, trunks, door frames, corners), and how many of
+  /// them stand within kClassCone of `up`.
+  size_t lines = 0, standing_lines = 0;
 
   /// Whether the estimate is good to level by: measured better than the map
-  /// leans (levelled by it, what is left leans less than the map did).
-  bool levelable() const { return measured && uncertainty < angle; }
+  /// leans (levelled by it, what is left leans less than the map did), and
+  /// no further than kMaxLevelable; beyond kClassCone only where most of at
+  /// least kMinLines lines stand along it (linesStand).
+  bool levelable() const;
+  /// Whether the map's lines say `up` is up: at least kMinLines of them, and
+  /// most of them standing along it.
+  bool linesStand() const;
   /// Whether the map may lie within `tolerance`: its tilt less its
   /// uncertainty not beyond it (or not measured).
   bool mayBeWithin(double tolerance) const { return !measured || angle - uncertainty <= tolerance; }
@@ -54,9 +63,20 @@ Eigen::Matrix4d levelingMatrix(const Eigen::Vector3d& up);
 Eigen::Matrix4d betweenOwnFrames(const Eigen::Matrix4d& T, const Eigen::Vector3d& target_up,
                                  const Eigen::Vector3d& source_up);
 
-/// Beyond this lean the estimate can take walls for floors (a y-up map read
-/// 16-48 degrees): such a map is refused, never levelled.
-const double kMaxLevelable = radians(30.0);
+/// A flat patch whose normal lies within this of up is a floor's (ground,
+/// ceilings), within this of horizontal a wall's; the rest (stairs, clutter)
+/// says nothing. A map leaning beyond it may have its walls taken for floors:
+/// a hall on its side (turned 60-90 degrees) read 7-48 degrees off its walls,
+/// as tightly as a leaning map reads its floors. There the map's lines tell
+/// (Tilt::linesStand): in the hall, upright or leaning 20-45 degrees, most of
+/// its lines stood within 2 degrees of up; on its side, across the up read.
+const double kClassCone = radians(30.0);
+/// Fewer lines than this and they say nothing (as kMinPatches, for patches).
+constexpr size_t kMinLines = 20;
+
+/// Beyond this lean a map is never levelled by an estimate: its walls lie
+/// nearer z than its floors.
+const double kMaxLevelable = radians(45.0);
 
 /// Whether `up` is one a map may be levelled by: a unit vector within
 /// kMaxLevelable of z (what a peer may announce).

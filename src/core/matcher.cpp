@@ -137,13 +137,25 @@ std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string
   // or noisy LiDAR crops whose ground lies 1.5-2.3 deg off read 3.5-9.4 deg,
   // their halves disagreeing by as much). Levelling off (the daemon), only a
   // map surely beyond the tolerance is refused.
-  if (tilt.angle <= kMaxLevelable && (params.level || tilt.mayBeWithin(params.max_tilt))) return std::nullopt;
+  // Beyond kClassCone its walls may have been taken for floors: it is
+  // levelled where its lines say the up read is up, and refused otherwise.
+  const bool read_as_floors = tilt.angle <= kClassCone || (tilt.angle <= kMaxLevelable && tilt.linesStand());
+  if (read_as_floors && (params.level || tilt.mayBeWithin(params.max_tilt))) return std::nullopt;
   const std::string tilted = role + " map is tilted " + fixed(degrees(tilt.angle), 1) + " +- " +
                              fixed(degrees(tilt.uncertainty), 1) + " deg from gravity (matched as it is up to " +
                              fixed(degrees(params.max_tilt), 1) + " deg)";
-  if (!params.level && tilt.angle <= kMaxLevelable) return tilted + "; levelling is off: level the map first";
-  return tilted + ", too far to level (limit " + fixed(degrees(kMaxLevelable), 0) +
-         " deg): its axes may be swapped (y up); fix its frame, or give its up (--up-target, --up-source; the "
+  if (!params.level && read_as_floors) return tilted + "; levelling is off: level the map first";
+  const std::string why =
+      tilt.angle > kMaxLevelable
+          ? "too far to level (limit " + fixed(degrees(kMaxLevelable), 0) + " deg)"
+          : "too far to level by its floors alone (beyond " + fixed(degrees(kClassCone), 0) +
+                " deg its walls may pass for floors, and its lines do not tell them apart: " +
+                (tilt.lines < kMinLines ? std::to_string(tilt.lines) + " lines, too few"
+                                        : "only " + std::to_string(tilt.standing_lines) + " of its " +
+                                              std::to_string(tilt.lines) + " lines stand along that up") +
+                ")";
+  return tilted + ", " + why +
+         ": its axes may be swapped (y up); fix its frame, or give its up (--up-target, --up-source; the "
          "daemon's map_up)";
 }
 
@@ -172,9 +184,7 @@ MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimin
   // own error (0.6 deg on demo-pcd1) cost 3 cm and 0.6 deg on demo-room. A
   // known up has no error: the map is levelled by whatever it leans.
   const bool known = tilt.cue == Tilt::Cue::given;
-  const bool level =
-      params.level &&
-      (known ? tilt.angle > 0.0 : tilt.angle > params.max_tilt && tilt.angle <= kMaxLevelable && tilt.levelable());
+  const bool level = params.level && (known ? tilt.angle > 0.0 : tilt.angle > params.max_tilt && tilt.levelable());
   if (level) {
     // The levelled map is filtered again: rotated voxels no longer sit on the grid.
     filtered = voxelFilter(rotatePoints(filtered, tilt.leveling()), params.grid);

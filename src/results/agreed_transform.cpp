@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "core/gravity.hpp"
+#include "core/text.hpp"
 
 namespace tomomap {
 
@@ -54,7 +55,8 @@ nlohmann::json upJson(const Eigen::Vector3d& up) { return {up.x(), up.y(), up.z(
 Eigen::Vector3d upFromJson(const nlohmann::json& j, const std::string& what) {
   const auto v = j.get<std::array<double, 3>>();
   const Eigen::Vector3d up(v[0], v[1], v[2]);
-  if (!levelableUp(up)) throw InputError(what + " is not a unit vector within 30 deg of z");
+  if (!levelableUp(up))
+    throw InputError(what + " is not a unit vector within " + fixed(degrees(kMaxLevelable), 0) + " deg of z");
   return up;
 }
 

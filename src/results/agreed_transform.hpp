@@ -76,7 +76,7 @@ nlohmann::json matrixJson(const Eigen::Matrix4d& M);
 /// A map's up direction as stored: [x, y, z].
 nlohmann::json upJson(const Eigen::Vector3d& up);
 /// The inverse; throws InputError naming `what` for anything but a unit
-/// vector within 30 deg of z (what a map may be levelled by).
+/// vector within kMaxLevelable of z (what a map may be levelled by).
 Eigen::Vector3d upFromJson(const nlohmann::json& j, const std::string& what);
 
 /// The inverse for a rigid transform; throws InputError (or a json exception) for anything else.

@@ -1,5 +1,8 @@
 #include "rejection.hpp"
 
+#include "core/gravity.hpp"
+#include "core/text.hpp"
+
 namespace tomomap::transport {
 
 std::string Rejection::text() const {
@@ -28,7 +31,7 @@ std::string Rejection::text() const {
       return "announcement with unseen slices out of range, out of order or sent (from slice " + std::to_string(slice) +
              ")";
     case Reject::BadUp:
-      return "an up direction that is not a unit vector within 30 deg of z";
+      return "an up direction that is not a unit vector within " + fixed(degrees(kMaxLevelable), 0) + " deg of z";
     case Reject::NotAnnounced:
       return "slice " + std::to_string(slice) + " was not announced";
     case Reject::PartNumbering:

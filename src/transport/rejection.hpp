@@ -18,7 +18,7 @@ enum class Reject {
   VersionMismatch,  ///< announcement whose version is not the hash of its content
   BadUnseen,        ///< announcement: an unseen run out of range, out of order or over a slice it sends
   UnpairedUnseen,   ///< announcement: an unseen run without its last slice (an odd number of bounds)
-  BadUp,            ///< announcement or estimate: an up that is not a unit vector within 30 deg of z
+  BadUp,            ///< announcement or estimate: an up that is not a unit vector within kMaxLevelable of z
   NotAnnounced,     ///< sample of a slice the announcement does not list
   PartNumbering,
   MixedEncoding,

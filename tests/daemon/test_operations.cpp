@@ -404,8 +404,9 @@ TEST(Operations, ALeaningMapIsLevelledAndAgreedAgainButNeitherJunkNorAMapLeaning
   EXPECT_EQ(matchesComputedReaching(fleet, {"alpha", "bravo"}, 3), 3)
       << "the first agreement, the levelled map's and the junk map's, once each";
 
-  // A map leaning 40 degrees (beyond what an estimate read off floors and
-  // walls can be trusted at): never levelled, refused as an update, the last map staying on offer.
+  // A map leaning 40 degrees (beyond the floors' cone, where its walls may
+  // pass for floors, and the room has no lines to tell them apart): never
+  // levelled, refused as an update, the last map staying on offer.
   const Points too_far =
       rotatePoints(original, Eigen::Quaterniond(Eigen::AngleAxisd(radians(40), Eigen::Vector3d::UnitX())));
   const std::string v3 = fleet.readJson("bravo", "status.json")["map"]["version"];

@@ -110,7 +110,7 @@ TEST(DaemonConfig, AMapsKnownUpIsThreeNumbersAndLeavesTheEstimateAlone) {
     EXPECT_NE(e.find("'map_up': must be a non-zero direction"), std::string::npos) << bad << ": " << e;
   }
   const std::string side = errorOf(dir, base + "map_up = \"0, 1, 0\"\n");
-  EXPECT_NE(side.find("'map_up': leans 90.0 deg from z: a map is levelled by at most 30 deg"), std::string::npos)
+  EXPECT_NE(side.find("'map_up': leans 90.0 deg from z: a map is levelled by at most 45 deg"), std::string::npos)
       << side << ": peers would refuse every announcement of it";
 }
 

@@ -39,6 +39,21 @@ Points furnishedRoom(bool leaning_walls = false) {
   return p;
 }
 
+/// The furnished room with `posts` upright posts across it (10 cm thick, as
+/// tall as the room): the lines a hall's posts, trunks and door frames give.
+Points roomWithPosts(int posts) {
+  Points p = furnishedRoom();
+  for (int k = 0; k < posts; ++k) {
+    const Eigen::Vector2f at(1.0f + 4.0f * static_cast<float>(k % 3) / 2.0f, k < 3 ? 1.0f : 4.0f);
+    for (float z = 0.03f; z < 2.8f; z += 0.03f)
+      for (int a = 0; a < 8; ++a) {
+        const float t = static_cast<float>(a) * 0.785398f;
+        p.emplace_back(at.x() + 0.05f * std::cos(t), at.y() + 0.05f * std::sin(t), z);
+      }
+  }
+  return p;
+}
+
 Eigen::Quaterniond lean(double deg, const Eigen::Vector3d& axis) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(radians(deg), axis.normalized()));
 }
@@ -101,6 +116,24 @@ TEST(Gravity, ALeaningRoomReadsItsLeanAndLevellingUndoesIt) {
   }
 }
 
+TEST(Gravity, BeyondTheFloorsConeAMapIsLevelledOnlyWhereItsLinesStandAlongUp) {
+  // Beyond kClassCone a map's walls may pass for floors: it is levelled where
+  // its lines (here six posts) stand along the up read, refused without them.
+  for (const double deg : {35.0, 42.0}) {
+    const Eigen::Quaterniond q = lean(deg, {1, 0.4, 0});
+    const Tilt posts = estimateTilt(rotatePoints(roomWithPosts(6), q), 0.05);
+    ASSERT_TRUE(posts.measured) << deg;
+    EXPECT_NEAR(degrees(posts.angle), deg, 0.3) << deg;
+    EXPECT_TRUE(posts.linesStand()) << deg << ": " << posts.standing_lines << " of " << posts.lines;
+    EXPECT_TRUE(posts.levelable()) << deg << ": " << leanText(posts);
+    const Tilt bare = estimateTilt(rotatePoints(furnishedRoom(), q), 0.05);
+    ASSERT_TRUE(bare.measured) << deg;
+    EXPECT_NEAR(degrees(bare.angle), deg, 0.3) << deg;
+    EXPECT_LT(bare.lines, kMinLines) << deg;
+    EXPECT_FALSE(bare.levelable()) << deg << ": nothing tells its floors from its walls";
+  }
+}
+
 TEST(Gravity, AFewScatteredPointsAreNotMeasured) {
   Points p;
   std::mt19937 rng(3);
@@ -126,9 +159,21 @@ TEST(Matcher, ATiltNotMeasuredBetterThanItLeansIsMatchedAsItIs) {
   EXPECT_TRUE(map(7.5, 4.0).tilt.levelable()) << "levelled, it leans at most 4 deg where it leaned 7.5";
   EXPECT_FALSE(tiltRefusal(map(4.6, 5.0), "target", params)) << "not measured better than it leans: as it is";
   EXPECT_FALSE(tiltRefusal(map(25.0, 26.0), "target", params));
-  const auto far = tiltRefusal(map(40, 20), "source", params);
+  const auto far = tiltRefusal(map(50, 1), "source", params);
   ASSERT_TRUE(far) << "beyond what is ever levelled";
-  EXPECT_NE(far->find("too far to level"), std::string::npos) << *far;
+  EXPECT_NE(far->find("too far to level (limit 45 deg)"), std::string::npos) << *far;
+  // Beyond kClassCone, where a wall may pass for a floor, the map's lines tell.
+  MapFeatures standing = map(40, 1), lying = map(40, 1), bare = map(40, 1);
+  standing.tilt.lines = lying.tilt.lines = 30;
+  standing.tilt.standing_lines = 25;
+  lying.tilt.standing_lines = 3;
+  bare.tilt.lines = bare.tilt.standing_lines = 5;
+  EXPECT_TRUE(standing.tilt.levelable());
+  EXPECT_FALSE(tiltRefusal(standing, "source", params));
+  const auto side = tiltRefusal(lying, "source", params), unknown = tiltRefusal(bare, "source", params);
+  ASSERT_TRUE(side && unknown) << "its walls may have been read as floors";
+  EXPECT_NE(side->find("only 3 of its 30 lines stand along that up"), std::string::npos) << *side;
+  EXPECT_NE(unknown->find("5 lines, too few"), std::string::npos) << *unknown;
   MatchParams no_level;
   no_level.level = false;
   EXPECT_TRUE(tiltRefusal(map(5.0, 0.1), "source", no_level)) << "surely tilted, levelling off";
