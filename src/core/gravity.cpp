@@ -19,18 +19,19 @@ namespace {
 constexpr double kPatchCells = 8.0;
 constexpr double kMinPatchSide = 0.4;  ///< [m]: below, voxel noise tilts the patches
 constexpr size_t kMinPatchPoints = 12;
+/// The cubes' edge at `grid` [m].
 double cubeSide(double grid) { return std::max(kMinPatchSide, kPatchCells * grid); }
 /// Flat: the thinnest extent well below the other two (eigenvalues of the
 /// patch's covariance), and the patch not a line.
 constexpr double kFlatness = 0.05, kNotALine = 0.2;
 constexpr int kRounds = 4;
 /// Fewer flat patches than this and a cue (floors, walls) says nothing.
-constexpr size_t kMinPatches = kMinLines;
+constexpr size_t kMinPatches = 20;
 /// Walls tell up only where they face two ways: the scatter's middle
 /// eigenvalue at least this share of its largest.
 constexpr double kTwoWays = 0.1;
-/// Patches whose normals lie within this of each other count as one
-/// direction's: a floor's patches scatter a few degrees (the hall's by 2-4).
+/// Normals (and lines) within this of each other count as one direction's:
+/// a floor's patches scatter a few degrees (the hall's by 2-4).
 const double kModeCone = radians(10.0);
 /// A patch leaning off its kind's fit more than this many times the median is not of that kind.
 constexpr double kOutlierLeans = 3.0;
@@ -89,11 +90,11 @@ using Cubes = std::unordered_map<uint64_t, Sums>;
 Cubes cubesOf(const Points& map, const Part& part, const Eigen::Matrix3f& turn, double side, float shift = 0) {
   Cubes cubes;
   const bool turned = !turn.isIdentity(0.0f);
-  const Eigen::Vector3f moved = Eigen::Vector3f::Constant(shift);
+  const Eigen::Vector3f moved = Eigen::Vector3f::Constant(shift);  // exact where 0: the same cubes
   for (size_t i = 0; i < map.size(); i += part.stride) {
     if (!part.holds(map[i])) continue;
     const Eigen::Vector3f p = turned ? turnedBy(turn, map[i]) : map[i];
-    Sums& s = cubes[latticeKey(shift == 0 ? p : Eigen::Vector3f(p + moved), side)];
+    Sums& s = cubes[latticeKey(Eigen::Vector3f(p + moved), side)];
     const Eigen::Vector3d q = p.cast<double>();
     s.sum += q;
     // The upper triangle alone: the lower one is the same products.
@@ -159,7 +160,7 @@ std::pair<size_t, size_t> standingLines(const Points& map, const Part& part, con
     const auto there = shifted.find(latticeKey(Eigen::Vector3f(centre + to_shifted), side));
     if (there == shifted.end()) continue;
     const auto again = lineOf(there->second);
-    if (!again || std::abs(again->dot(*line)) < std::cos(kClassCone)) continue;
+    if (!again || std::abs(again->dot(*line)) < std::cos(kModeCone)) continue;
     ++lines;
     standing += std::abs(line->z()) >= std::cos(kClassCone);
   }
@@ -277,8 +278,9 @@ std::optional<Cue> upBeyondTheCone(const std::vector<Patch>& patches, Tilt& t) {
 }
 
 /// The estimate itself (see estimateTilt): `up` from the flat patches of
-/// `part` of `map`, measured again in the frame levelled so far.
-Tilt measureTilt(const Points& map, double grid, const Part& part) {
+/// `part` of `map`, measured again in the frame levelled so far; from beyond
+/// kClassCone too (upBeyondTheCone) where `may_restart`.
+Tilt measureTilt(const Points& map, double grid, const Part& part, bool may_restart) {
   // The cubes are axis-aligned: a leaning floor cut at a cube's top and bottom
   // fits a little flatter than it is (a 10 deg lean read as 9.3). Measured
   // again in the frame levelled so far, the cut runs along the floor.
@@ -289,7 +291,10 @@ Tilt measureTilt(const Points& map, double grid, const Part& part) {
     const Eigen::Matrix3f turn = leveling.toRotationMatrix().cast<float>();  // as rotatePoints turns
     const std::vector<Patch> patches = flatPatches(map, part, turn, side);
     auto cue = upOf(patches, Eigen::Vector3d::UnitZ(), t);
-    if (!cue && pass == 0) cue = upBeyondTheCone(patches, t);
+    if (!cue && pass == 0 && may_restart) {
+      cue = upBeyondTheCone(patches, t);
+      t.beyond_cone = cue.has_value();
+    }
     if (!cue) return t;
     leveling = Eigen::Quaterniond::FromTwoVectors(cue->up, Eigen::Vector3d::UnitZ()) * leveling;
     t.uncertainty = cue->error();
@@ -297,6 +302,7 @@ Tilt measureTilt(const Points& map, double grid, const Part& part) {
   t.measured = true;
   t.up = (leveling.inverse() * Eigen::Vector3d::UnitZ()).normalized();
   t.angle = std::acos(std::clamp(t.up.z(), -1.0, 1.0));
+  t.beyond_cone = t.beyond_cone || t.angle > kClassCone;
   return t;
 }
 
@@ -326,9 +332,9 @@ std::vector<Part> partsOf(const Points& map) {
 }  // namespace
 
 Tilt estimateTilt(const Points& map, double grid, std::optional<double> matched_within) {
-  Tilt t = measureTilt(map, grid, sampleOf(map));
+  Tilt t = measureTilt(map, grid, sampleOf(map), true);
   if (!t.measured || (matched_within && t.angle <= *matched_within)) return t;
-  if (t.angle > kClassCone && t.angle <= kMaxLevelable) {
+  if (t.beyond_cone && t.angle <= kMaxLevelable) {
     // In the frame the estimate levels the map into, where a lattice's cut
     // runs along the floors (measureTilt).
     const Eigen::Matrix3f turn = t.leveling().toRotationMatrix().cast<float>();
@@ -352,8 +358,9 @@ Tilt estimateTilt(const Points& map, double grid, std::optional<double> matched_
   const std::vector<Part> parts = partsOf(map);
   for (const Part& part : parts) {
     // The same estimate a crop of the map would get (one pass from the
-    // whole's frame read campus-1's halves 0.1 deg nearer than a crop's own).
-    const Tilt p = measureTilt(map, grid, part);
+    // whole's frame read campus-1's halves 0.1 deg nearer than a crop's own);
+    // from beyond the cone only where the whole was read there.
+    const Tilt p = measureTilt(map, grid, part, t.beyond_cone);
     if (!fairPart(p, t)) continue;
     ++checks;
     farthest = std::max(farthest, std::acos(std::clamp(p.up.dot(t.up), -1.0, 1.0)));
@@ -396,9 +403,9 @@ std::string leanText(const Tilt& t) {
 
 bool Tilt::linesStand() const { return lines >= kMinLines && 2 * standing_lines > lines; }
 
-bool Tilt::levelable() const {
-  return measured && uncertainty < angle && angle <= kMaxLevelable && (angle <= kClassCone || linesStand());
-}
+bool Tilt::upTrusted() const { return angle <= kMaxLevelable && (!beyond_cone || linesStand()); }
+
+bool Tilt::levelable() const { return measured && uncertainty < angle && upTrusted(); }
 
 Eigen::Quaterniond Tilt::leveling() const { return levelingOf(up); }
 

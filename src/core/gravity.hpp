@@ -29,15 +29,19 @@ struct Tilt {
   enum class Cue { floors, walls, given } cue = Cue::floors;
   size_t floor_patches = 0;  ///< flat patches facing up (floors, ceilings, ground)
   size_t wall_patches = 0;   ///< flat patches facing sideways (walls)
-  /// Read where the map leans beyond kClassCone (a wall may pass for a floor
-  /// there): its lines (posts, trunks, door frames, corners), and how many of
-  /// them stand within kClassCone of `up`.
+  /// Read beyond kClassCone, or found from there (the rounds from z finding
+  /// nothing): its walls may pass for its floors, and its lines must tell.
+  bool beyond_cone = false;
+  /// Where beyond_cone: its lines (posts, trunks, door frames, corners), and
+  /// how many of them stand within kClassCone of `up`.
   size_t lines = 0, standing_lines = 0;
 
-  /// Whether the estimate is good to level by: measured better than the map
-  /// leans (levelled by it, what is left leans less than the map did), and
-  /// no further than kMaxLevelable; beyond kClassCone only where most of at
-  /// least kMinLines lines stand along it (linesStand).
+  /// Whether `up` may be taken for the floors': within kMaxLevelable, and
+  /// beyond kClassCone only where the map's lines stand along it.
+  bool upTrusted() const;
+  /// Whether the estimate is good to level by: `up` trusted, and measured
+  /// better than the map leans (levelled by it, what is left leans less than
+  /// the map did).
   bool levelable() const;
   /// Whether the map's lines say `up` is up: at least kMinLines of them, and
   /// most of them standing along it.
@@ -65,13 +69,13 @@ Eigen::Matrix4d betweenOwnFrames(const Eigen::Matrix4d& T, const Eigen::Vector3d
 
 /// A flat patch whose normal lies within this of up is a floor's (ground,
 /// ceilings), within this of horizontal a wall's; the rest (stairs, clutter)
-/// says nothing. A map leaning beyond it may have its walls taken for floors:
-/// a hall on its side (turned 60-90 degrees) read 7-48 degrees off its walls,
-/// as tightly as a leaning map reads its floors. There the map's lines tell
-/// (Tilt::linesStand): in the hall, upright or leaning 20-45 degrees, most of
-/// its lines stood within 2 degrees of up; on its side, across the up read.
+/// says nothing; a line within this of up stands. A map read leaning beyond
+/// it may have had its walls taken for floors, as tightly as a leaning map's
+/// floors are read; there its lines tell (Tilt::linesStand; measured:
+/// docs/results.md, "Maps that lean 30-45 degrees, and maps on their side").
 const double kClassCone = radians(30.0);
-/// Fewer lines than this and they say nothing (as kMinPatches, for patches).
+/// Fewer lines than this and they say nothing: a few posts' worth (a 3 m post
+/// is 7 cubes at 0.4 m; the hall's half-sequence held 58-114).
 constexpr size_t kMinLines = 20;
 
 /// Beyond this lean a map is never levelled by an estimate: its walls lie

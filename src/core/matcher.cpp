@@ -129,34 +129,40 @@ void matchSlices(MatchResult& r, FeatureProposals& e, const MapFeatures& target,
 
 }  // namespace
 
+namespace {
+
+/// Why a map whose up is not trusted (Tilt::upTrusted) cannot be levelled by it.
+std::string untrustedUp(const Tilt& tilt) {
+  if (tilt.angle > kMaxLevelable) return "too far to level (limit " + fixed(degrees(kMaxLevelable), 0) + " deg)";
+  return "too far to level by its planes alone (beyond " + fixed(degrees(kClassCone), 0) +
+         " deg its walls may pass for floors, and its lines do not tell them apart: " +
+         (tilt.lines < kMinLines ? std::to_string(tilt.lines) + " lines, too few"
+                                 : "only " + std::to_string(tilt.standing_lines) + " of its " +
+                                       std::to_string(tilt.lines) + " lines stand along that up") +
+         ")";
+}
+
+}  // namespace
+
 std::optional<std::string> tiltRefusal(const MapFeatures& map, const std::string& role, const MatchParams& params) {
   const Tilt& tilt = map.tilt;
   if (map.leveled || !tilt.measured || tilt.angle <= params.max_tilt) return std::nullopt;
-  // Levelling on, a map within the levelling limit that was not levelled
-  // was not measured better than it leans: it is matched as it is (thinned
-  // or noisy LiDAR crops whose ground lies 1.5-2.3 deg off read 3.5-9.4 deg,
-  // their halves disagreeing by as much). Levelling off (the daemon), only a
-  // map surely beyond the tolerance is refused.
-  // Beyond kClassCone its walls may have been taken for floors: it is
-  // levelled where its lines say the up read is up, and refused otherwise.
-  const bool read_as_floors = tilt.angle <= kClassCone || (tilt.angle <= kMaxLevelable && tilt.linesStand());
-  if (read_as_floors && (params.level || tilt.mayBeWithin(params.max_tilt))) return std::nullopt;
+  // Levelling on, a map whose up is trusted but was not levelled was not
+  // measured better than it leans: within kClassCone it is matched as it is
+  // (thinned or noisy LiDAR crops whose ground lies 1.5-2.3 deg off read
+  // 3.5-9.4 deg, their halves disagreeing by as much); beyond it, leaning
+  // that far whatever its parts read, it is refused. Levelling off
+  // (--no-level), only a map surely beyond the tolerance is refused.
+  const bool as_it_is = params.level ? !tilt.beyond_cone : tilt.mayBeWithin(params.max_tilt);
+  if (tilt.upTrusted() && as_it_is) return std::nullopt;
   const std::string tilted = role + " map is tilted " + fixed(degrees(tilt.angle), 1) + " +- " +
                              fixed(degrees(tilt.uncertainty), 1) + " deg from gravity (matched as it is up to " +
                              fixed(degrees(params.max_tilt), 1) + " deg)";
-  if (!params.level && read_as_floors) return tilted + "; levelling is off: level the map first";
-  const std::string why =
-      tilt.angle > kMaxLevelable
-          ? "too far to level (limit " + fixed(degrees(kMaxLevelable), 0) + " deg)"
-          : "too far to level by its floors alone (beyond " + fixed(degrees(kClassCone), 0) +
-                " deg its walls may pass for floors, and its lines do not tell them apart: " +
-                (tilt.lines < kMinLines ? std::to_string(tilt.lines) + " lines, too few"
-                                        : "only " + std::to_string(tilt.standing_lines) + " of its " +
-                                              std::to_string(tilt.lines) + " lines stand along that up") +
-                ")";
-  return tilted + ", " + why +
-         ": its axes may be swapped (y up); fix its frame, or give its up (--up-target, --up-source; the "
-         "daemon's map_up)";
+  const std::string remedy = "give its up (--up-target, --up-source; the daemon's map_up)";
+  if (!tilt.upTrusted())
+    return tilted + ", " + untrustedUp(tilt) + ": its axes may be swapped (y up); fix its frame, or " + remedy;
+  if (!params.level) return tilted + "; levelling is off: level the map first";
+  return tilted + ", not measured better than it leans (its parts read it that far apart): " + remedy;
 }
 
 MapFeatures describeMap(const Points& map, const MatchParams& params, StageTimings* timings, size_t* filtered_points,

@@ -415,6 +415,7 @@ TEST(Operations, ALeaningMapIsLevelledAndAgreedAgainButNeitherJunkNorAMapLeaning
       [&] { return !fleet.readJson("bravo", "status.json")["map"].value("update_refused", "").empty(); }, 60s))
       << fleet.log("bravo");
   EXPECT_NE(fleet.log("bravo").find("own map is tilted "), std::string::npos) << fleet.log("bravo");
+  EXPECT_NE(fleet.log("bravo").find("too far to level by its planes alone"), std::string::npos) << fleet.log("bravo");
   EXPECT_EQ(fleet.readJson("bravo", "status.json")["map"]["version"], v3) << "the last map stays on offer";
   const auto view = runTomomap("status " + (dir / "out-bravo"));
   EXPECT_NE(view.output.find("NOT offered: "), std::string::npos) << view.output;

@@ -132,6 +132,19 @@ TEST(Gravity, BeyondTheFloorsConeAMapIsLevelledOnlyWhereItsLinesStandAlongUp) {
     EXPECT_LT(bare.lines, kMinLines) << deg;
     EXPECT_FALSE(bare.levelable()) << deg << ": nothing tells its floors from its walls";
   }
+  // Turned 50-55 degrees, its floors lie beyond kMaxLevelable and a wall
+  // nearer z reads as them: its posts lie across that up.
+  for (const double deg : {50.0, 55.0}) {
+    MapFeatures f;
+    f.tilt = estimateTilt(rotatePoints(roomWithPosts(6), lean(deg, {1, 0, 0})), 0.05);
+    ASSERT_TRUE(f.tilt.measured) << deg;
+    EXPECT_NEAR(degrees(f.tilt.angle), 90 - deg, 0.5) << deg << ": a wall read";
+    EXPECT_GE(f.tilt.lines, kMinLines) << deg;
+    EXPECT_FALSE(f.tilt.levelable()) << deg << ": " << f.tilt.standing_lines << " of " << f.tilt.lines;
+    const auto refused = tiltRefusal(f, "target", MatchParams{});
+    ASSERT_TRUE(refused) << deg;
+    EXPECT_NE(refused->find("lines stand along that up"), std::string::npos) << *refused;
+  }
 }
 
 TEST(Gravity, AFewScatteredPointsAreNotMeasured) {
@@ -152,6 +165,7 @@ TEST(Matcher, ATiltNotMeasuredBetterThanItLeansIsMatchedAsItIs) {
     f.tilt.measured = true;
     f.tilt.angle = radians(deg);
     f.tilt.uncertainty = radians(uncertainty_deg);
+    f.tilt.beyond_cone = f.tilt.angle > kClassCone;  // as estimateTilt reads it
     return f;
   };
   const MatchParams params;  // matched as it is up to 3 deg
@@ -169,11 +183,24 @@ TEST(Matcher, ATiltNotMeasuredBetterThanItLeansIsMatchedAsItIs) {
   lying.tilt.standing_lines = 3;
   bare.tilt.lines = bare.tilt.standing_lines = 5;
   EXPECT_TRUE(standing.tilt.levelable());
+  standing.leveled = true;  // as describeMap levels it
   EXPECT_FALSE(tiltRefusal(standing, "source", params));
+  standing.leveled = false;
   const auto side = tiltRefusal(lying, "source", params), unknown = tiltRefusal(bare, "source", params);
   ASSERT_TRUE(side && unknown) << "its walls may have been read as floors";
   EXPECT_NE(side->find("only 3 of its 30 lines stand along that up"), std::string::npos) << *side;
   EXPECT_NE(unknown->find("5 lines, too few"), std::string::npos) << *unknown;
+  MapFeatures half = map(40, 1);
+  half.tilt.lines = 20;
+  half.tilt.standing_lines = 10;
+  EXPECT_FALSE(half.tilt.linesStand()) << "half of them is not most";
+  // Its lines standing but its parts reading it further apart than it
+  // leans: not matched as it is, as a map within the cone would be.
+  MapFeatures loose = standing;
+  loose.tilt.uncertainty = radians(41);
+  const auto unsure = tiltRefusal(loose, "source", params);
+  ASSERT_TRUE(unsure) << "a map leaning 40 deg is not matched as it is";
+  EXPECT_NE(unsure->find("not measured better than it leans"), std::string::npos) << *unsure;
   MatchParams no_level;
   no_level.level = false;
   EXPECT_TRUE(tiltRefusal(map(5.0, 0.1), "source", no_level)) << "surely tilted, levelling off";
