@@ -75,7 +75,7 @@ Eigen::Matrix4d betweenOwnFrames(const Eigen::Matrix4d& T, const Eigen::Vector3d
 /// docs/results.md, "Maps that lean 30-45 degrees, and maps on their side").
 const double kClassCone = radians(30.0);
 /// Fewer lines than this and they say nothing: a few posts' worth (a 3 m post
-/// is 7 cubes at 0.4 m; the hall's half-sequence held 58-114).
+/// is 7 cubes at 0.4 m; the hall leaning or on its side held 41-97).
 constexpr size_t kMinLines = 20;
 
 /// Beyond this lean a map is never levelled by an estimate: its walls lie
