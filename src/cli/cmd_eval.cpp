@@ -315,6 +315,7 @@ int runEval(const EvalOptions& o) {
       synth::SequencePairParams params;
       params.seed = static_cast<uint64_t>(seed);
       params.level = q.level;
+      params.turn_deg = q.turn;
       params.max_range = q.range;
       params.move_xy = q.move;
       auto& scans = sequences[{q.scans, q.poses}];
@@ -330,11 +331,11 @@ int runEval(const EvalOptions& o) {
         } catch (const InputError&) {
           ups[up_key] = Eigen::Vector3d::Constant(NAN);
         }
-      if (q.level && !ups[up_key].allFinite())
+      if ((q.level || q.turn != 0) && !ups[up_key].allFinite())
         throw InputError(q.scans +
                          ": the sequence's flat surfaces do not tell its up direction: its maps cannot be "
                          "levelled (level = false cuts them as they lean)");
-      const std::string variant = q.level ? "level" : "lean";
+      const std::string variant = q.turn != 0 ? "turned" + shortNumber(q.turn) : q.level ? "level" : "lean";
       const std::string folder = q.name + "-" + std::to_string(seed) + "-g" + shortNumber(q.grid) + "-" + variant;
       std::cerr << "cutting " << folder << "\n";
       std::string what;
@@ -348,7 +349,11 @@ int runEval(const EvalOptions& o) {
       }
       suite.pairs.push_back({q.name + "-" + std::to_string(seed) + "-g" + shortNumber(q.grid) + "-" + what, w.maps[0],
                              w.maps[1], w.poses[0], w.poses[1], q.grid, "real",
-                             q.name + " g" + shortNumber(q.grid) + (q.level ? " levelled" : " leaning"), q.methods});
+                             q.name + " g" + shortNumber(q.grid) +
+                                 (q.turn != 0 ? " turned " + shortNumber(q.turn)
+                                  : q.level   ? " levelled"
+                                              : " leaning"),
+                             q.methods});
     }
 
   std::ofstream rows_csv(out / "rows.csv");

@@ -167,7 +167,8 @@ Suite loadSuite(const std::string& path) {
       s.scans.push_back(c);
   });
   forEachTable(path, root, "sequence", [&](const toml::table& t) {
-    checkKeys(path, t, {"folder", "scans", "poses", "name", "seeds", "grid", "level", "range", "move", "methods"},
+    checkKeys(path, t,
+              {"folder", "scans", "poses", "name", "seeds", "grid", "level", "turn", "range", "move", "methods"},
               "[[sequence]]");
     SuiteSequence q;
     if (!t.get("folder") && !(t.get("scans") && t.get("poses")))
@@ -184,6 +185,11 @@ Suite loadSuite(const std::string& path) {
       if (!n->is_boolean()) fail(path, n->source(), "'level' must be true or false");
       q.level = n->value<bool>().value();
     }
+    q.turn = number(path, t, "turn", q.turn);
+    if (const toml::node* n = t.get("turn"); n && !(q.turn >= 0 && q.turn <= 90))
+      fail(path, n->source(), "'turn' must be 0 to 90 degrees");
+    if (const toml::node* n = t.get("turn"); n && q.turn != 0 && q.level)
+      fail(path, n->source(), "'turn' levels each map first: leave 'level' out");
     q.range = number(path, t, "range", q.range);
     q.move = number(path, t, "move", q.move);
     q.methods = blockMethods(t);

@@ -47,8 +47,9 @@ struct SuiteSequence {
   std::string poses;  ///< their pose file: KITTI, TUM or FAST-LIO's (io/pose_sequence.hpp)
   std::string name;   ///< family name; default: sequenceName(scans)
   std::vector<int64_t> seeds{1};
-  double grid = MatchParams{}.grid;                      ///< [m]
-  bool level = false;                                    ///< each map levelled instead of leaning as its SLAM saved it
+  double grid = MatchParams{}.grid;  ///< [m]
+  bool level = false;                ///< each map levelled instead of leaning as its SLAM saved it
+  double turn = 0;  ///< each map levelled, then turned this far [deg] (synth::SequencePairParams::turn_deg)
   double range = synth::SequencePairParams{}.max_range;  ///< each scan's points kept within [m]
   double move = synth::SequencePairParams{}.move_xy;     ///< the source's largest x, y move [m]
   std::vector<std::string> methods;                      ///< as for [[synth]]

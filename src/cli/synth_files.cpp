@@ -99,6 +99,7 @@ GeneratedWorld writeSequencePair(const std::vector<PosedScan>& scans, const Eige
                         {"overlap", {{"target", i.target_overlap}, {"source", i.source_overlap}}},
                         {"lean_deg", {{"target", degrees(i.target_lean)}, {"source", degrees(i.source_lean)}}},
                         {"levelled", i.level},
+                        {"turned_deg", i.turn_deg},
                         {"range_m", {params.min_range, params.max_range}},
                         {"voxel_m", params.voxel},
                         {"move", {{"x", i.move.x}, {"y", i.move.y}, {"z", i.move.z}, {"yaw_deg", degrees(i.move.yaw)}}},

@@ -112,6 +112,17 @@ SequencePair makeSequencePair(const std::vector<PosedScan>& scans, const Eigen::
   info.level = params.level;
   info.move = Pose4{params.move_xy * (2 * unit(rng) - 1), params.move_xy * (2 * unit(rng) - 1),
                     params.move_z * (2 * unit(rng) - 1), 2 * kPi * unit(rng) - kPi};
+  info.turn_deg = params.turn_deg;
+  // Drawn after everything else, so that a turned pair is the same pair turned.
+  const auto turn = [&] {
+    Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+    if (params.turn_deg == 0) return T;
+    const double a = 2 * kPi * unit(rng);
+    T.topLeftCorner<3, 3>() =
+        Eigen::AngleAxisd(radians(params.turn_deg), Eigen::Vector3d(std::cos(a), std::sin(a), 0)).toRotationMatrix();
+    return T;
+  };
+  const Eigen::Matrix4d target_turn = turn(), source_turn = turn();
 
   const Points target_world = accumulate(scans, a0, a1, params);
   const Points source_world = accumulate(scans, b0, b1, params);
@@ -122,8 +133,9 @@ SequencePair makeSequencePair(const std::vector<PosedScan>& scans, const Eigen::
   Eigen::Matrix4d leveling = Eigen::Matrix4d::Identity();
   leveling.topLeftCorner<3, 3>() = Eigen::Quaterniond::FromTwoVectors(up, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   SequencePair pair;
-  pair.target.pose = mapFrame(scans[a0].T_world_body, leveling, params.level);
-  pair.source.pose = info.move.matrix() * mapFrame(scans[b0].T_world_body, leveling, params.level);
+  const bool level = params.level || params.turn_deg != 0;
+  pair.target.pose = target_turn * mapFrame(scans[a0].T_world_body, leveling, level);
+  pair.source.pose = info.move.matrix() * source_turn * mapFrame(scans[b0].T_world_body, leveling, level);
   info.target_lean = leanOf(pair.target.pose, up);
   info.source_lean = leanOf(pair.source.pose, up);
   pair.target.points = transformed(target_world, pair.target.pose);
@@ -139,7 +151,11 @@ SequencePair makeSequencePair(const std::vector<PosedScan>& scans, const Eigen::
 std::string describe(const SequencePairInfo& info) {
   std::ostringstream o;
   o << "o" << std::lround(100 * info.overlap()) << "-kf" << info.target_first << "-" << info.target_last << "-"
-    << info.source_first << "-" << info.source_last << (info.level ? "-level" : "-lean");
+    << info.source_first << "-" << info.source_last;
+  if (info.turn_deg != 0)
+    o << "-turned" << info.turn_deg;
+  else
+    o << (info.level ? "-level" : "-lean");
   return o.str();
 }
 

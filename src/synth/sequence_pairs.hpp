@@ -30,6 +30,10 @@ struct SequencePairParams {
   /// Each map levelled (its z axis turned onto the sequence's up, only x, y,
   /// z and yaw of its first keyframe kept) instead of leaning as saved.
   bool level = false;
+  /// Each map levelled, then turned this far [deg] about a horizontal axis
+  /// drawn per map: a SLAM started on a slope or held tilted, leaning more
+  /// than the sequence's own keyframes do (0: not turned).
+  double turn_deg = 0;
   /// The source's move: x and y within +-move_xy, z within +-move_z [m], any yaw.
   double move_xy = 20, move_z = 2;
 };
@@ -41,7 +45,8 @@ struct SequencePairInfo {
   double target_overlap = 0, source_overlap = 0;
   double target_lean = 0, source_lean = 0;  ///< angle of each map's z axis from the sequence's up [rad]
   bool level = false;
-  Pose4 move;  ///< applied to the source after it was put in its own frame
+  double turn_deg = 0;  ///< SequencePairParams::turn_deg
+  Pose4 move;           ///< applied to the source after it was put in its own frame
 
   /// The pair's overlap: the smaller share (the harder side).
   double overlap() const { return std::min(target_overlap, source_overlap); }

@@ -60,6 +60,17 @@ TEST(Eval, SuiteErrorsNameFileLineAndProblem) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("key.toml:3:"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("unknown key 'seed'"), std::string::npos) << r.output;
+
+  // A sequence turned is levelled first: asking for both, or a turn past 90 deg, is said where.
+  std::ofstream(dir / "turn.toml") << "[[sequence]]\nfolder = \"seq\"\nlevel = true\nturn = 40\n";
+  r = runTomomap("eval " + (dir / "turn.toml") + " -o " + (dir / "out"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("turn.toml:4:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("'turn' levels each map first"), std::string::npos) << r.output;
+  std::ofstream(dir / "far.toml") << "[[sequence]]\nfolder = \"seq\"\nturn = 120\n";
+  r = runTomomap("eval " + (dir / "far.toml") + " -o " + (dir / "out"));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("'turn' must be 0 to 90 degrees"), std::string::npos) << r.output;
 }
 
 TEST(Eval, MissingMapIsLeftOutAndTheRestRuns) {

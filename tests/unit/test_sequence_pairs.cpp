@@ -123,6 +123,28 @@ TEST(SequencePairs, TheGroundTruthPutsEveryPointBackAndMapsLeanAsTheirFirstKeyfr
     }
 }
 
+TEST(SequencePairs, ATurnedPairIsTheSamePairWithEachMapLeaningAsTurned) {
+  const auto scans = walk(radians(6.0));
+  SequencePairParams params;
+  params.max_range = 10;
+  const Eigen::Vector3d up = sequenceUp(scans, params);
+  params.level = true;
+  const SequencePair level = makeSequencePair(scans, up, params);
+  params.level = false;
+  params.turn_deg = 40;
+  const SequencePair turned = makeSequencePair(scans, up, params);
+  const auto& i = turned.info;
+  SCOPED_TRACE(describe(i));
+  EXPECT_NE(describe(i).find("-turned40"), std::string::npos);
+  EXPECT_EQ(i.target_first, level.info.target_first);
+  EXPECT_EQ(i.source_last, level.info.source_last);
+  EXPECT_EQ(i.move.yaw, level.info.move.yaw) << "the same pair, turned";
+  EXPECT_NEAR(degrees(i.target_lean), 40.0, 1e-6);
+  EXPECT_NEAR(degrees(i.source_lean), 40.0, 1e-6);
+  EXPECT_LT(offTheHall(turned.target), 0.05) << "the ground truth still puts every point back";
+  EXPECT_LT(offTheHall(turned.source), 0.05);
+}
+
 TEST(SequencePairs, IsDeterministicFromItsSeedAndRefusesATooShortSequence) {
   const auto scans = walk(0.0);
   SequencePairParams params;
