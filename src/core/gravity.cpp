@@ -332,13 +332,14 @@ std::vector<Part> partsOf(const Points& map) {
 }  // namespace
 
 Tilt estimateTilt(const Points& map, double grid, std::optional<double> matched_within) {
-  Tilt t = measureTilt(map, grid, sampleOf(map), true);
+  const Part sample = sampleOf(map);
+  Tilt t = measureTilt(map, grid, sample, true);
   if (!t.measured || (matched_within && t.angle <= *matched_within)) return t;
   if (t.beyond_cone && t.angle <= kMaxLevelable) {
     // In the frame the estimate levels the map into, where a lattice's cut
     // runs along the floors (measureTilt).
     const Eigen::Matrix3f turn = t.leveling().toRotationMatrix().cast<float>();
-    std::tie(t.lines, t.standing_lines) = standingLines(map, sampleOf(map), turn, cubeSide(grid));
+    std::tie(t.lines, t.standing_lines) = standingLines(map, sample, turn, cubeSide(grid));
   }
   t.checked = true;
   // A standard error counts the patches as independent; they are not (a
