@@ -43,34 +43,22 @@ static std::string slurp(const std::string& path) {
 
 TEST(Eval, SuiteErrorsNameFileLineAndProblem) {
   TempDir dir;
-  std::ofstream(dir / "syntax.toml") << "name = \"x\"\n[[pair]\ntarget = 1\n";
-  auto r = runTomomap("eval " + (dir / "syntax.toml") + " -o " + (dir / "out"));
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("syntax.toml:2:"), std::string::npos) << r.output;
-
-  std::ofstream(dir / "method.toml")
-      << "name = \"x\"\nmethods = [\"tomomap\", \"icp\"]\n[[synth]]\nworld = \"indoor\"\n";
-  r = runTomomap("eval " + (dir / "method.toml") + " -o " + (dir / "out"));
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("method.toml:2:"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("unknown method 'icp'"), std::string::npos) << r.output;
-
-  std::ofstream(dir / "key.toml") << "[[synth]]\nworld = \"indoor\"\nseed = [1]\n";
-  r = runTomomap("eval " + (dir / "key.toml") + " -o " + (dir / "out"));
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("key.toml:3:"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("unknown key 'seed'"), std::string::npos) << r.output;
-
+  // The suite `name` holding `text` is refused (exit code 2), its error saying each of `says`.
+  const auto refused = [&](const std::string& name, const std::string& text, std::vector<std::string> says) {
+    SCOPED_TRACE(name);
+    std::ofstream(dir / name) << text;
+    const auto r = runTomomap("eval " + (dir / name) + " -o " + (dir / "out"));
+    EXPECT_EQ(r.exit_code, 2);
+    for (const std::string& s : says) EXPECT_NE(r.output.find(s), std::string::npos) << s << "\n" << r.output;
+  };
+  refused("syntax.toml", "name = \"x\"\n[[pair]\ntarget = 1\n", {"syntax.toml:2:"});
+  refused("method.toml", "name = \"x\"\nmethods = [\"tomomap\", \"icp\"]\n[[synth]]\nworld = \"indoor\"\n",
+          {"method.toml:2:", "unknown method 'icp'"});
+  refused("key.toml", "[[synth]]\nworld = \"indoor\"\nseed = [1]\n", {"key.toml:3:", "unknown key 'seed'"});
   // A sequence turned is levelled first: asking for both, or a turn past 90 deg, is said where.
-  std::ofstream(dir / "turn.toml") << "[[sequence]]\nfolder = \"seq\"\nlevel = true\nturn = 40\n";
-  r = runTomomap("eval " + (dir / "turn.toml") + " -o " + (dir / "out"));
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("turn.toml:4:"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("'turn' levels each map first"), std::string::npos) << r.output;
-  std::ofstream(dir / "far.toml") << "[[sequence]]\nfolder = \"seq\"\nturn = 120\n";
-  r = runTomomap("eval " + (dir / "far.toml") + " -o " + (dir / "out"));
-  EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("'turn' must be 0 to 90 degrees"), std::string::npos) << r.output;
+  refused("turn.toml", "[[sequence]]\nfolder = \"seq\"\nlevel = true\nturn = 40\n",
+          {"turn.toml:4:", "'turn' levels each map first"});
+  refused("far.toml", "[[sequence]]\nfolder = \"seq\"\nturn = 120\n", {"'turn' must be 0 to 90 degrees"});
 }
 
 TEST(Eval, MissingMapIsLeftOutAndTheRestRuns) {
