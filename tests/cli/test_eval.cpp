@@ -43,22 +43,21 @@ static std::string slurp(const std::string& path) {
 
 TEST(Eval, SuiteErrorsNameFileLineAndProblem) {
   TempDir dir;
-  // The suite `name` holding `text` is refused (exit code 2), its error saying each of `says`.
-  const auto refused = [&](const std::string& name, const std::string& text, std::vector<std::string> says) {
-    SCOPED_TRACE(name);
-    std::ofstream(dir / name) << text;
-    const auto r = runTomomap("eval " + (dir / name) + " -o " + (dir / "out"));
+  // The suite `text` (evalSuite's s.toml) is refused (exit code 2), its error saying each of `says`.
+  const auto refused = [&](const std::string& what, const std::string& text, const std::vector<std::string>& says) {
+    SCOPED_TRACE(what);
+    const auto r = evalSuite(dir, text);
     EXPECT_EQ(r.exit_code, 2);
     for (const std::string& s : says) EXPECT_NE(r.output.find(s), std::string::npos) << s << "\n" << r.output;
   };
-  refused("syntax.toml", "name = \"x\"\n[[pair]\ntarget = 1\n", {"syntax.toml:2:"});
-  refused("method.toml", "name = \"x\"\nmethods = [\"tomomap\", \"icp\"]\n[[synth]]\nworld = \"indoor\"\n",
-          {"method.toml:2:", "unknown method 'icp'"});
-  refused("key.toml", "[[synth]]\nworld = \"indoor\"\nseed = [1]\n", {"key.toml:3:", "unknown key 'seed'"});
+  refused("syntax", "name = \"x\"\n[[pair]\ntarget = 1\n", {"s.toml:2:"});
+  refused("method", "name = \"x\"\nmethods = [\"tomomap\", \"icp\"]\n[[synth]]\nworld = \"indoor\"\n",
+          {"s.toml:2:", "unknown method 'icp'"});
+  refused("key", "[[synth]]\nworld = \"indoor\"\nseed = [1]\n", {"s.toml:3:", "unknown key 'seed'"});
   // A sequence turned is levelled first: asking for both, or a turn past 90 deg, is said where.
-  refused("turn.toml", "[[sequence]]\nfolder = \"seq\"\nlevel = true\nturn = 40\n",
-          {"turn.toml:4:", "'turn' levels each map first"});
-  refused("far.toml", "[[sequence]]\nfolder = \"seq\"\nturn = 120\n", {"'turn' must be 0 to 90 degrees"});
+  refused("turn with level", "[[sequence]]\nfolder = \"seq\"\nlevel = true\nturn = 40\n",
+          {"s.toml:4:", "'turn' levels each map first"});
+  refused("turn past 90", "[[sequence]]\nfolder = \"seq\"\nturn = 120\n", {"'turn' must be 0 to 90 degrees"});
 }
 
 TEST(Eval, MissingMapIsLeftOutAndTheRestRuns) {
